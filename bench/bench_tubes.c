@@ -1,0 +1,466 @@
+/* bench_tubes.c — the experiment of Russig et al. (4, Fig. 5) for `tubes`, plus accuracy tables.
+ *
+ *   bench-tubes [--size WxH] [--frames N] [--datasets fibers,hotroom,bundle,brain,furball]
+ *               [--skip-perf] [--skip-error] [--skip-cubic]
+ *
+ * 1. Speed: generated stand-ins for the paper's five datasets (about 3.5k,
+ *    31k, 106k, 114k, 787k segments) in a far view (the bounding sphere fits
+ *    the 45 degree view) and a close view (1/3 of that distance), an orbit of
+ *    N frames each: median frame ms of tubes, tubes with the empty fragment
+ *    shader (silhouette_only), tubes_mesh; ratio; triangles; GPU memory.
+ * 2. Error against time: root method x iterations (4..32), depth error
+ *    against the CPU reference (tests/render/tubes/tubes_reference.c) and ms.
+ * 3. How far the quadratic pair lies from the true cubic Hermite sweep
+ *    (both by the reference) on smaller versions of the five datasets.
+ * Defaults (160x90, 3 frames) take a few minutes on llvmpipe; --size
+ * 1920x1080 --frames 1000 is the paper's setting. VTK's tube filter is not
+ * compared (not done). Prints Markdown; checks nothing. Render thread = main.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/sl_line_style.h"
+#include "core/sl_technique.h"
+#include "data/sl_generate.h"
+#include "gpu/sl_gpu.h"
+#include "pipeline/sl_pipeline.h"
+#include "tubes/tubes_nodes.h"
+
+/* The reference intersector is test code kept apart from the renderer library
+ * (it must share nothing with the shader path); compiled into this program. */
+#include "../tests/render/tubes/tubes_reference.c"
+
+typedef struct bench_dataset {
+    const char *name;       /* the paper's dataset it stands in for */
+    const char *json;       /* full size */
+    const char *json_small; /* for the cubic-vs-quadratic table */
+} bench_dataset;
+
+static const bench_dataset datasets[] = {
+    {"fibers", "{\"generator\":\"tornado\",\"lines\":241,\"points\":16,\"seed\":1}",
+     "{\"generator\":\"tornado\",\"lines\":60,\"points\":16,\"seed\":1}"},
+    {"hotroom", "{\"generator\":\"hotroom\",\"lines\":12400,\"seed\":1}",
+     "{\"generator\":\"hotroom\",\"lines\":1000,\"seed\":1}"},
+    {"bundle", "{\"generator\":\"bundle\",\"lines\":1250,\"points\":85,\"seed\":1}",
+     "{\"generator\":\"bundle\",\"lines\":40,\"points\":85,\"seed\":1}"},
+    {"brain", "{\"generator\":\"abc\",\"lines\":1701,\"points\":68,\"seed\":1}",
+     "{\"generator\":\"abc\",\"lines\":40,\"points\":68,\"seed\":1}"},
+    {"furball", "{\"generator\":\"furball\",\"segments\":787327,\"seed\":1}",
+     "{\"generator\":\"furball\",\"segments\":3000,\"seed\":1}"},
+};
+#define DATASET_COUNT ((int)(sizeof datasets / sizeof datasets[0]))
+
+typedef struct options {
+    int width, height, frames, skip_perf, skip_error, skip_cubic;
+    const char *only;
+} options;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : 0.0;
+}
+
+static size_t segment_count(const sl_dataset *ds)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < ds->lines.line_count; k++) {
+        size_t len = ds->lines.line_offsets[k + 1] - ds->lines.line_offsets[k];
+        n += len >= 2 ? len - 1 : 0;
+    }
+    return n;
+}
+
+static sl_status make_view(const sl_dataset *ds, double azimuth, double distance, int w, int h, sl_view *view,
+                           sl_err *err)
+{
+    memset(view, 0, sizeof *view);
+    view->width = w;
+    view->height = h;
+    view->origin = ds->origin;
+    view->background[3] = 1.0f;
+    sl_orbit o = {azimuth, 20.0, distance, 45.0};
+    sl_status st = sl_camera_from_orbit(&o, ds->bounds_min, ds->bounds_max, &view->camera, err);
+    return st == SL_OK ? sl_view_init(view, sl_dataset_radius(ds), err) : st;
+}
+
+typedef struct run_result { double ms, primitives; size_t bytes; } run_result;
+
+/* Median frame ms over an orbit of `frames` frames (the first frame, which
+ * prepares, is rendered once before timing). */
+static sl_status run_orbit(sl_pipeline *p, const sl_technique *t, const sl_params *params, double distance,
+                           const options *o, run_result *out, sl_err *err)
+{
+    sl_status st = sl_pipeline_set_technique(p, t, params, err);
+    if (st != SL_OK)
+        return st;
+    const sl_dataset *ds = sl_pipeline_dataset(p);
+    double *ms = calloc((size_t)o->frames, sizeof *ms);
+    if (!ms)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    sl_view view;
+    sl_frame_stats stats = {0};
+    if ((st = make_view(ds, 0.0, distance, o->width, o->height, &view, err)) == SL_OK)
+        st = sl_pipeline_render(p, &view, 1, &stats, err);
+    for (int f = 0; st == SL_OK && f < o->frames; f++) {
+        if ((st = make_view(ds, 360.0 * f / o->frames, distance, o->width, o->height, &view, err)) != SL_OK ||
+            (st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
+            break;
+        ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
+    }
+    out->ms = median(ms, o->frames);
+    out->primitives = stats.render.primitives;
+    out->bytes = stats.gpu_bytes;
+    free(ms);
+    return st;
+}
+
+static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
+{
+    const sl_technique *tubes = sl_technique_find("tubes"), *mesh = sl_technique_find("tubes_mesh");
+    if (!tubes || !mesh)
+        return sl_err_set(err, SL_ERR_UNSUPPORTED, "tubes or tubes_mesh is not registered");
+    printf("\n## Speed (%dx%d, median of %d orbit frames, ms)\n\n", o->width, o->height, o->frames);
+    printf("| dataset | segments | view | tubes | silhouette only | tubes_mesh | mesh / tubes | tubes triangles | mesh triangles | tubes MB | mesh MB |\n");
+    printf("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (int d = 0; d < DATASET_COUNT; d++) {
+        if (o->only && !strstr(o->only, datasets[d].name))
+            continue;
+        sl_dataset *ds = NULL;
+        sl_status st = sl_generate_json(datasets[d].json, &ds, err);
+        if (st != SL_OK)
+            return st;
+        size_t segs = segment_count(ds);
+        sl_pipeline *p = NULL;
+        if ((st = sl_pipeline_create(gpu, &p, err)) != SL_OK) {
+            sl_dataset_destroy(ds);
+            return st;
+        }
+        sl_pipeline_set_dataset(p, ds);
+        const double far = 1.0 / sin(22.5 * SL_PI / 180.0); /* bounding sphere fits the 45 degree view */
+        const double dists[2] = {far, far / 3.0};
+        const char *names[2] = {"far", "close"};
+        for (int v = 0; v < 2 && st == SL_OK; v++) {
+            sl_params tp, sp, mp;
+            sl_params_init(&tp, tubes->params, tubes->param_count);
+            sl_params_init(&sp, tubes->params, tubes->param_count);
+            sl_params_init(&mp, mesh->params, mesh->param_count);
+            double one = 1.0;
+            sl_params_set_numbers(&sp, "silhouette_only", &one, 1, err);
+            run_result rt = {0}, rs = {0}, rm = {0};
+            if ((st = run_orbit(p, tubes, &tp, dists[v], o, &rt, err)) != SL_OK ||
+                (st = run_orbit(p, tubes, &sp, dists[v], o, &rs, err)) != SL_OK ||
+                (st = run_orbit(p, mesh, &mp, dists[v], o, &rm, err)) != SL_OK)
+                break;
+            printf("| %s | %zu | %s | %.1f | %.1f | %.1f | %.2f | %.0f | %.0f | %.1f | %.1f |\n", datasets[d].name, segs,
+                   names[v], rt.ms, rs.ms, rm.ms, rt.ms > 0 ? rm.ms / rt.ms : 0.0, rt.primitives, rm.primitives,
+                   rt.bytes / 1048576.0, rm.bytes / 1048576.0);
+            fflush(stdout);
+        }
+        sl_pipeline_destroy(p);
+        if (st != SL_OK)
+            return st;
+    }
+    printf("\n(tubes triangles: box faces emitted by the geometry shader, 2 per face, after culling.)\n");
+    return SL_OK;
+}
+
+/* Depth error of a GPU distance map against the reference, x the local radius. */
+typedef struct error_stats { double max_all, max_inner, mean; long mismatch, both; } error_stats;
+
+static error_stats compare(const float *gpu, const float *ref, const float *rad, const int *seg, int w, int h)
+{
+    error_stats e = {0};
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) {
+            size_t k = (size_t)j * (size_t)w + (size_t)i;
+            int a = gpu[k] > 0.0f, b = ref[k] > 0.0f;
+            if (a != b || !isfinite(gpu[k])) {
+                e.mismatch++;
+                continue;
+            }
+            if (!a)
+                continue;
+            double rel = fabs((double)gpu[k] - ref[k]) / fmax(rad[k], 1e-30);
+            int sil = 0;
+            for (int dj = -1; dj <= 1; dj++)
+                for (int di = -1; di <= 1; di++) {
+                    int x = i + di, y = j + dj;
+                    if (x < 0 || y < 0 || x >= w || y >= h)
+                        continue;
+                    size_t n = (size_t)y * (size_t)w + (size_t)x;
+                    sil |= (ref[n] > 0.0f) != b || seg[n] != seg[k] || fabsf(ref[n] - ref[k]) > rad[k];
+                }
+            e.max_all = fmax(e.max_all, rel);
+            if (!sil)
+                e.max_inner = fmax(e.max_inner, rel);
+            e.mean += rel;
+            e.both++;
+        }
+    if (e.both)
+        e.mean /= (double)e.both;
+    return e;
+}
+
+static sl_status reference_of(const sl_dataset *ds, const sl_view *view, const sl_params *params, int cubic,
+                              float *ref, float *rad, int *seg, sl_err *err)
+{
+    sl_tubes_nodes nodes;
+    sl_status st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1,
+                                        &nodes, err);
+    if (st != SL_OK)
+        return st;
+    sl_line_style style;
+    sl_line_style_read(params, ds, &style);
+    tubes_ref_desc rd = {.view = view, .origin = ds->origin, .nodes = &nodes, .radius = style.radius,
+                         .radius_scale = style.radius_scale, .cubic = cubic};
+    tubes_ref_render(&rd, ref, rad, seg);
+    sl_tubes_nodes_deinit(&nodes);
+    return SL_OK;
+}
+
+static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
+{
+    const char *json = "{\"generator\":\"bundle\",\"lines\":100,\"points\":50,\"seed\":2}";
+    (void)o;
+    const int w = 128, h = 128;
+    sl_dataset *ds = NULL;
+    sl_status st = sl_generate_json(json, &ds, err);
+    if (st != SL_OK)
+        return st;
+    const sl_technique *tubes = sl_technique_find("tubes");
+    sl_params params;
+    sl_params_init(&params, tubes->params, tubes->param_count);
+    double radius = sl_dataset_radius(ds) / 60.0; /* tubes several pixels wide, so most pixels are not at a rim */
+    sl_params_set_numbers(&params, "radius", &radius, 1, err);
+    sl_view view;
+    size_t np = (size_t)w * h;
+    float *ref = calloc(np, sizeof *ref), *rad = calloc(np, sizeof *rad), *gpu_d = calloc(np, sizeof *gpu_d);
+    int *seg = calloc(np, sizeof *seg);
+    sl_pipeline *p = NULL;
+    if (!ref || !rad || !gpu_d || !seg) {
+        st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    if ((st = make_view(ds, 30.0, 1.2, w, h, &view, err)) != SL_OK ||
+        (st = reference_of(ds, &view, &params, 0, ref, rad, seg, err)) != SL_OK ||
+        (st = sl_pipeline_create(gpu, &p, err)) != SL_OK)
+        goto done;
+    size_t segs = segment_count(ds);
+    sl_pipeline_set_dataset(p, ds);
+    ds = NULL;
+    printf("\n## Depth error against the reference, by root method and iterations\n\n");
+    printf("bundle, %zu segments, radius 1/60 of the bounding radius, %dx%d, close view; error in units of the local "
+           "tube radius; \"away\" excludes reference silhouettes (3x3 coverage/segment/depth-jump change).\n\n", segs, w, h);
+    printf("| method | iterations | max error (away) | max error (all) | mean error | coverage mismatch | frame ms |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|\n");
+    static const int iters[] = {4, 6, 8, 10, 12, 16, 20, 24, 32};
+    const int ni = (int)(sizeof iters / sizeof iters[0]);
+    int need[2] = {-1, -1};
+    for (int m = 0; m < 2; m++)
+        for (int k = 0; k < ni; k++) {
+            double it = iters[k], method = m;
+            sl_params_set_numbers(&params, "iterations", &it, 1, err);
+            sl_params_set_numbers(&params, "root_method", &method, 1, err);
+            if ((st = sl_pipeline_set_technique(p, tubes, &params, err)) != SL_OK)
+                goto done;
+            double ms[3];
+            sl_frame_stats stats;
+            for (int f = 0; f < 3; f++) {
+                if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
+                    goto done;
+                ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
+            }
+            sl_pipeline_read_distance(p, &view, gpu_d);
+            error_stats e = compare(gpu_d, ref, rad, seg, w, h);
+            if (need[m] < 0 && e.max_inner <= 1e-3 && e.mean <= 1e-4)
+                need[m] = iters[k];
+            printf("| %s | %d | %.3g | %.3g | %.3g | %ld | %.1f |\n", m ? "illinois" : "bisection", iters[k],
+                   e.max_inner, e.max_all, e.mean, e.mismatch, median(ms, 3));
+            fflush(stdout);
+        }
+    printf("\nFewest iterations (of those tried) for max error away from silhouettes <= 1e-3 and mean error <= 1e-4 "
+           "(x radius): bisection %d, illinois %d", need[0], need[1]);
+    if (need[0] > 0 && need[1] > 0)
+        printf(" (ratio %.2f)", (double)need[0] / need[1]);
+    printf(".\n");
+done:
+    sl_pipeline_destroy(p);
+    sl_dataset_destroy(ds);
+    free(ref);
+    free(rad);
+    free(gpu_d);
+    free(seg);
+    return st;
+}
+
+/* Max and mean over segments of max_t |quadratic pair(t) - cubic Hermite(t)| / radius. */
+static void curve_deviation(const sl_dataset *ds, const sl_params *params, double *dmax, double *dmean)
+{
+    *dmax = *dmean = 0.0;
+    sl_tubes_nodes n;
+    sl_err err;
+    if (sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1, &n, &err) != SL_OK)
+        return;
+    sl_line_style style;
+    sl_line_style_read(params, ds, &style);
+    for (size_t s = 0; s < n.segment_count; s++) {
+        const float *a = n.geometry + (size_t)n.segments[2 * s] * SL_TUBES_NODE_FLOATS;
+        const float *b = n.geometry + (size_t)n.segments[2 * s + 1] * SL_TUBES_NODE_FLOATS;
+        double r = n.has_radii ? 0.5 * (a[3] + b[3]) * style.radius_scale : style.radius;
+        double worst = 0.0;
+        for (int k = 0; k <= 64; k++) {
+            double t = k / 64.0, d2 = 0.0;
+            for (int c = 0; c < 3; c++) {
+                double p0 = a[c], t0 = a[4 + c], p1 = b[c], t1 = b[4 + c];
+                double t2 = t * t, t3 = t2 * t;
+                double cub = (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * t0 + (-2 * t3 + 3 * t2) * p1 + (t3 - t2) * t1;
+                double a2 = p0 + t0 / 3, b2 = p1 - t1 / 3, m = 0.5 * (a2 + b2), quad;
+                if (t <= 0.5) {
+                    double u = 2 * t, v = 1 - u;
+                    quad = v * v * p0 + 2 * u * v * a2 + u * u * m;
+                } else {
+                    double u = 2 * t - 1, v = 1 - u;
+                    quad = v * v * m + 2 * u * v * b2 + u * u * p1;
+                }
+                d2 += (quad - cub) * (quad - cub);
+            }
+            worst = fmax(worst, sqrt(d2));
+        }
+        worst /= fmax(r, 1e-30);
+        *dmax = fmax(*dmax, worst);
+        *dmean += worst;
+    }
+    if (n.segment_count)
+        *dmean /= (double)n.segment_count;
+    sl_tubes_nodes_deinit(&n);
+}
+
+static sl_status bench_cubic(const options *o, sl_err *err)
+{
+    const int w = 96, h = 96;
+    printf("\n## Quadratic pair against the true cubic Hermite sweep (reference, both)\n\n");
+    printf("Smaller versions of the generated datasets, %dx%d, far view, default radius. Curve deviation: max and mean "
+           "over segments of |quadratic pair(t) - cubic(t)| at equal parameter (an upper bound of the distance "
+           "between the curves); depth difference on pixels both hit away from silhouettes, and over all pixels both "
+           "hit (there a rim may switch to another tube). All in units of the tube radius.\n\n", w, h);
+    printf("| dataset | segments | curve dev. max | curve dev. mean | depth max (away) | depth mean (away) | "
+           "depth max (all) | coverage mismatch |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    const sl_technique *tubes = sl_technique_find("tubes");
+    for (int d = 0; d < DATASET_COUNT; d++) {
+        if (o->only && !strstr(o->only, datasets[d].name))
+            continue;
+        sl_dataset *ds = NULL;
+        sl_status st = sl_generate_json(datasets[d].json_small, &ds, err);
+        if (st != SL_OK)
+            return st;
+        sl_params params;
+        sl_params_init(&params, tubes->params, tubes->param_count);
+        size_t np = (size_t)w * h;
+        float *q = calloc(np, sizeof *q), *qr = calloc(np, sizeof *qr), *c = calloc(np, sizeof *c),
+              *cr = calloc(np, sizeof *cr);
+        int *seg = calloc(np, sizeof *seg);
+        sl_view view;
+        if (!q || !qr || !c || !cr || !seg)
+            st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+        if (st == SL_OK && (st = make_view(ds, 30.0, 1.0 / sin(22.5 * SL_PI / 180.0), w, h, &view, err)) == SL_OK &&
+            (st = reference_of(ds, &view, &params, 0, q, qr, seg, err)) == SL_OK &&
+            (st = reference_of(ds, &view, &params, 1, c, cr, seg, err)) == SL_OK) {
+            double mx = 0.0, mean = 0.0, mx_all = 0.0;
+            long both = 0, mism = 0;
+            for (int j = 0; j < h; j++)
+                for (int i = 0; i < w; i++) {
+                    size_t k = (size_t)j * w + i;
+                    int a = q[k] > 0.0f, b = c[k] > 0.0f;
+                    mism += a != b;
+                    if (!(a && b))
+                        continue;
+                    double e = fabs((double)q[k] - c[k]) / fmax(cr[k], 1e-30);
+                    mx_all = fmax(mx_all, e);
+                    int sil = 0;
+                    for (int dj = -1; dj <= 1; dj++)
+                        for (int di = -1; di <= 1; di++) {
+                            int x = i + di, y = j + dj;
+                            if (x < 0 || y < 0 || x >= w || y >= h)
+                                continue;
+                            size_t n = (size_t)y * w + x;
+                            sil |= (c[n] > 0.0f) != b || fabsf(c[n] - c[k]) > cr[k];
+                        }
+                    if (sil)
+                        continue;
+                    mx = fmax(mx, e);
+                    mean += e;
+                    both++;
+                }
+            double dev_max, dev_mean;
+            curve_deviation(ds, &params, &dev_max, &dev_mean);
+            printf("| %s | %zu | %.3g | %.3g | %.3g | %.3g | %.3g | %ld |\n", datasets[d].name, segment_count(ds), dev_max,
+                   dev_mean, mx, both ? mean / both : 0.0, mx_all, mism);
+            fflush(stdout);
+        }
+        free(q); free(qr); free(c); free(cr); free(seg);
+        sl_dataset_destroy(ds);
+        if (st != SL_OK)
+            return st;
+    }
+    return SL_OK;
+}
+
+int main(int argc, char **argv)
+{
+    options o = {.width = 160, .height = 90, .frames = 3};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--skip-perf") == 0) o.skip_perf = 1;
+        else if (strcmp(a, "--skip-error") == 0) o.skip_error = 1;
+        else if (strcmp(a, "--skip-cubic") == 0) o.skip_cubic = 1;
+        else if (strcmp(a, "--size") == 0 && i + 1 < argc) {
+            if (sscanf(argv[++i], "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 ||
+                o.width > 8192 || o.height > 8192) {
+                fprintf(stderr, "bench-tubes: --size WxH, 1..8192\n");
+                return 1;
+            }
+        } else if (strcmp(a, "--frames") == 0 && i + 1 < argc) {
+            o.frames = atoi(argv[++i]);
+            if (o.frames < 1 || o.frames > 100000) {
+                fprintf(stderr, "bench-tubes: --frames in [1, 100000]\n");
+                return 1;
+            }
+        } else if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
+            o.only = argv[++i];
+        } else {
+            fprintf(stderr, "usage: bench-tubes [--size WxH] [--frames N] [--datasets fibers,hotroom,bundle,brain,furball]\n"
+                            "                   [--skip-perf] [--skip-error] [--skip-cubic]\n");
+            return 1;
+        }
+    }
+    sl_err err = {0};
+    sl_gpu *gpu = NULL;
+    if (sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &gpu, &err) != SL_OK) {
+        fprintf(stderr, "bench-tubes: GPU: %s\n", err.message);
+        return 3;
+    }
+    printf("# bench-tubes — %s\n", sl_gpu_renderer(gpu));
+    sl_status st = SL_OK;
+    if (!o.skip_perf)
+        st = bench_speed(gpu, &o, &err);
+    if (st == SL_OK && !o.skip_error)
+        st = bench_error(gpu, &o, &err);
+    if (st == SL_OK && !o.skip_cubic)
+        st = bench_cubic(&o, &err);
+    sl_gpu_destroy(gpu);
+    if (st != SL_OK) {
+        fprintf(stderr, "bench-tubes: %s\n", err.message);
+        return 2;
+    }
+    printf("\nVTK tube filter comparison: not done.\n");
+    return 0;
+}

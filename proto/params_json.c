@@ -1,0 +1,135 @@
+/* params_json.c — technique parameters to and from JSON (see sl_params_json.h). */
+#include "sl_params_json.h"
+
+#include "data/sl_dataset.h"
+
+#include <math.h>
+#include <string.h>
+
+static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
+{
+    const char *name = item->string;
+    int i = sl_params_find(p, name);
+    if (i < 0) {
+        double dummy = 0.0;
+        return sl_params_set_numbers(p, name, &dummy, 1, err); /* reports the unknown name with the known list */
+    }
+    const sl_param_def *d = &p->schema[i];
+    switch (d->type) {
+    case SL_PARAM_BOOL:
+        if (!cJSON_IsBool(item))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be true or false", name);
+        return sl_params_set_numbers(p, name, &(double){cJSON_IsTrue(item) ? 1.0 : 0.0}, 1, err);
+    case SL_PARAM_ENUM:
+        if (cJSON_IsString(item))
+            return sl_params_set_choice(p, name, item->valuestring, err);
+        if (cJSON_IsNumber(item))
+            return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a choice name", name);
+    case SL_PARAM_VEC3: {
+        double v[3];
+        if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an array of 3 numbers in [%g, %g]", name, d->min, d->max);
+        for (int k = 0; k < 3; k++) {
+            const cJSON *e = cJSON_GetArrayItem(item, k);
+            if (!cJSON_IsNumber(e))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an array of 3 numbers in [%g, %g]", name, d->min, d->max);
+            v[k] = e->valuedouble;
+        }
+        return sl_params_set_numbers(p, name, v, 3, err);
+    }
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_INT:
+        if (!cJSON_IsNumber(item))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a number in [%g, %g]", name, d->min, d->max);
+        return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
+    }
+    return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' has an unknown type", name);
+}
+
+sl_status sl_params_apply_json(sl_params *params, const cJSON *patch, sl_err *err)
+{
+    if (!patch || cJSON_IsNull(patch))
+        return SL_OK;
+    if (!cJSON_IsObject(patch))
+        return sl_err_set(err, SL_ERR_INVALID, "params must be an object of name: value");
+    sl_params next = *params;
+    for (const cJSON *item = patch->child; item; item = item->next) {
+        sl_status st = apply_one(&next, item, err);
+        if (st != SL_OK)
+            return st;
+    }
+    *params = next;
+    return SL_OK;
+}
+
+static cJSON *value_json(const sl_param_def *d, const double v[3])
+{
+    switch (d->type) {
+    case SL_PARAM_BOOL: return cJSON_CreateBool(v[0] != 0.0);
+    case SL_PARAM_ENUM: return cJSON_CreateString(d->choices[(int)v[0]]);
+    case SL_PARAM_VEC3: return cJSON_CreateDoubleArray(v, 3);
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_INT: return cJSON_CreateNumber(v[0]);
+    }
+    return cJSON_CreateNull();
+}
+
+cJSON *sl_params_to_json(const sl_params *p)
+{
+    cJSON *o = cJSON_CreateObject();
+    for (int i = 0; o && i < p->count; i++)
+        cJSON_AddItemToObject(o, p->schema[i].name, value_json(&p->schema[i], p->value[i]));
+    return o;
+}
+
+static const char *invalidation_name(sl_invalidation level)
+{
+    switch (level) {
+    case SL_INVALIDATE_NONE: return "none";
+    case SL_INVALIDATE_FRAME: return "frame";
+    case SL_INVALIDATE_PREPARED: return "prepared";
+    case SL_INVALIDATE_DATASET: return "dataset";
+    }
+    return "frame";
+}
+
+cJSON *sl_params_schema_json(const sl_param_def *schema, int count)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < count; i++) {
+        const sl_param_def *d = &schema[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", d->name);
+        cJSON_AddStringToObject(o, "type", sl_param_type_name(d->type));
+        if (d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3) {
+            cJSON_AddNumberToObject(o, "min", d->min);
+            cJSON_AddNumberToObject(o, "max", d->max);
+        }
+        cJSON_AddItemToObject(o, "default", value_json(d, d->def));
+        if (d->type == SL_PARAM_ENUM) {
+            cJSON *c = cJSON_AddArrayToObject(o, "choices");
+            for (int k = 0; d->choices[k]; k++)
+                cJSON_AddItemToArray(c, cJSON_CreateString(d->choices[k]));
+        }
+        cJSON_AddStringToObject(o, "unit", d->unit ? d->unit : "");
+        cJSON_AddStringToObject(o, "description", d->description ? d->description : "");
+        cJSON_AddStringToObject(o, "invalidates", invalidation_name(d->invalidates));
+        cJSON_AddItemToArray(a, o);
+    }
+    return a;
+}
+
+cJSON *sl_technique_json(const sl_technique *t)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", t->name);
+    cJSON_AddStringToObject(o, "description", t->description);
+    cJSON *kinds = cJSON_AddArrayToObject(o, "dataset_kinds");
+    const sl_dataset_kind all[] = {SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS};
+    for (int i = 0; i < 3; i++)
+        if (t->dataset_kinds & (unsigned)all[i])
+            cJSON_AddItemToArray(kinds, cJSON_CreateString(sl_dataset_kind_name(all[i])));
+    cJSON_AddItemToObject(o, "params", sl_params_schema_json(t->params, t->param_count));
+    return o;
+}

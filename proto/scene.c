@@ -1,0 +1,328 @@
+/* scene.c — scene documents: parse, override, resolve dataset and view (see sl_scene.h, scene.md).
+ * Any thread. Every error names the JSON path of the offending field. */
+#include "sl_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "data/sl_generate.h"
+#include "data/sl_load.h"
+#include "sl_params_json.h"
+
+static int key_allowed(const char *key, const char *const *allowed)
+{
+    for (int i = 0; allowed[i]; i++)
+        if (strcmp(key, allowed[i]) == 0)
+            return 1;
+    return 0;
+}
+
+static sl_status check_keys(const cJSON *obj, const char *path, const char *const *allowed, sl_err *err)
+{
+    for (const cJSON *c = obj->child; c; c = c->next)
+        if (!c->string || !key_allowed(c->string, allowed)) {
+            char list[256] = "";
+            for (int i = 0; allowed[i]; i++) {
+                strncat(list, allowed[i], sizeof list - strlen(list) - 1);
+                if (allowed[i + 1])
+                    strncat(list, ", ", sizeof list - strlen(list) - 1);
+            }
+            return sl_err_set(err, SL_ERR_INVALID, "%s%s%.64s: unknown field (allowed: %s)",
+                              path, *path ? "." : "", c->string ? c->string : "?", list);
+        }
+    return SL_OK;
+}
+
+static sl_status get_number(const cJSON *obj, const char *key, const char *path, double *out, int required, sl_err *err)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item) {
+        if (required)
+            return sl_err_set(err, SL_ERR_INVALID, "%s.%s is required", path, key);
+        return SL_OK;
+    }
+    if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble))
+        return sl_err_set(err, SL_ERR_INVALID, "%s.%s must be a finite number", path, key);
+    *out = item->valuedouble;
+    return SL_OK;
+}
+
+static sl_status get_vec3(const cJSON *obj, const char *key, const char *path, sl_vec3 *out, int required, sl_err *err)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item) {
+        if (required)
+            return sl_err_set(err, SL_ERR_INVALID, "%s.%s is required", path, key);
+        return SL_OK;
+    }
+    double v[3];
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3)
+        return sl_err_set(err, SL_ERR_INVALID, "%s.%s must be an array of 3 finite numbers", path, key);
+    for (int k = 0; k < 3; k++) {
+        const cJSON *e = cJSON_GetArrayItem(item, k);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+            return sl_err_set(err, SL_ERR_INVALID, "%s.%s must be an array of 3 finite numbers", path, key);
+        v[k] = e->valuedouble;
+    }
+    *out = sl_v3(v[0], v[1], v[2]);
+    return SL_OK;
+}
+
+sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camera, sl_orbit *orbit, sl_err *err)
+{
+    static const char *const camera_keys[] = {"eye", "target", "up", "fov_y", "orbit", NULL};
+    static const char *const orbit_keys[] = {"azimuth", "elevation", "distance", NULL};
+    if (!cJSON_IsObject(obj))
+        return sl_err_set(err, SL_ERR_INVALID, "camera must be an object");
+    sl_status st = check_keys(obj, "camera", camera_keys, err);
+    if (st != SL_OK)
+        return st;
+    double fov = 45.0;
+    if ((st = get_number(obj, "fov_y", "camera", &fov, 0, err)) != SL_OK)
+        return st;
+    if (!(fov > 0.0 && fov < 180.0))
+        return sl_err_set(err, SL_ERR_INVALID, "camera.fov_y must be in (0, 180) degrees, got %g", fov);
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(obj, "orbit");
+    if (o) {
+        if (cJSON_GetObjectItemCaseSensitive(obj, "eye") || cJSON_GetObjectItemCaseSensitive(obj, "target"))
+            return sl_err_set(err, SL_ERR_INVALID, "camera: give either orbit or eye/target, not both");
+        if (!cJSON_IsObject(o))
+            return sl_err_set(err, SL_ERR_INVALID, "camera.orbit must be an object");
+        if ((st = check_keys(o, "camera.orbit", orbit_keys, err)) != SL_OK)
+            return st;
+        sl_orbit r = {30.0, 20.0, 2.5, fov};
+        if ((st = get_number(o, "azimuth", "camera.orbit", &r.azimuth_deg, 0, err)) != SL_OK ||
+            (st = get_number(o, "elevation", "camera.orbit", &r.elevation_deg, 0, err)) != SL_OK ||
+            (st = get_number(o, "distance", "camera.orbit", &r.distance, 0, err)) != SL_OK)
+            return st;
+        if (!(r.distance > 0.0))
+            return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.distance must be > 0, got %g", r.distance);
+        *orbit = r;
+        *is_orbit = 1;
+        return SL_OK;
+    }
+    sl_camera c = {.up = sl_v3(0, 1, 0), .fov_y_deg = fov};
+    if ((st = get_vec3(obj, "eye", "camera", &c.eye, 1, err)) != SL_OK ||
+        (st = get_vec3(obj, "target", "camera", &c.target, 1, err)) != SL_OK ||
+        (st = get_vec3(obj, "up", "camera", &c.up, 0, err)) != SL_OK)
+        return st;
+    if ((st = sl_camera_validate(&c, err)) != SL_OK)
+        return st;
+    *camera = c;
+    *is_orbit = 0;
+    return SL_OK;
+}
+
+void sl_scene_deinit(sl_scene *s)
+{
+    cJSON_Delete(s->dataset);
+    cJSON_Delete(s->params);
+    memset(s, 0, sizeof *s);
+}
+
+sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
+{
+    static const char *const scene_keys[] = {"dataset", "technique", "params", "camera", "width", "height",
+                                             "background", "orbit_frames", "description", NULL};
+    memset(s, 0, sizeof *s);
+    snprintf(s->technique, sizeof s->technique, "tubes_mesh");
+    s->camera_is_orbit = 1;
+    s->orbit = (sl_orbit){30.0, 20.0, 2.5, 45.0};
+    s->width = s->height = 256;
+    const float bg[4] = {0.1f, 0.1f, 0.12f, 1.0f};
+    memcpy(s->background, bg, sizeof bg);
+    if (!cJSON_IsObject(root))
+        return sl_err_set(err, SL_ERR_INVALID, "a scene must be a JSON object");
+    sl_status st = check_keys(root, "", scene_keys, err);
+    if (st != SL_OK)
+        return st;
+    const cJSON *ds = cJSON_GetObjectItemCaseSensitive(root, "dataset");
+    if (!ds)
+        return sl_err_set(err, SL_ERR_INVALID, "dataset is required (a catalog name, a file path or {\"generator\": ...})");
+    if (!(cJSON_IsString(ds) && ds->valuestring[0]) && !cJSON_IsObject(ds))
+        return sl_err_set(err, SL_ERR_INVALID, "dataset must be a name, a path or a generator object");
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "technique");
+    if (t) {
+        if (!cJSON_IsString(t) || strlen(t->valuestring) >= sizeof s->technique)
+            return sl_err_set(err, SL_ERR_INVALID, "technique must be a technique name");
+        if (!sl_technique_find(t->valuestring)) {
+            int n;
+            const sl_technique *const *list = sl_technique_list(&n);
+            char names[256] = "";
+            for (int i = 0; i < n; i++) {
+                strncat(names, list[i]->name, sizeof names - strlen(names) - 1);
+                if (i + 1 < n)
+                    strncat(names, ", ", sizeof names - strlen(names) - 1);
+            }
+            return sl_err_set(err, SL_ERR_INVALID, "technique '%.64s' is unknown (known: %s)", t->valuestring, names);
+        }
+        snprintf(s->technique, sizeof s->technique, "%s", t->valuestring);
+    }
+    const cJSON *params = cJSON_GetObjectItemCaseSensitive(root, "params");
+    if (params && !cJSON_IsObject(params))
+        return sl_err_set(err, SL_ERR_INVALID, "params must be an object");
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (cam && (st = sl_camera_json_parse(cam, &s->camera_is_orbit, &s->camera, &s->orbit, err)) != SL_OK)
+        return st;
+    const char *size_keys[2] = {"width", "height"};
+    int *size_out[2] = {&s->width, &s->height};
+    for (int k = 0; k < 2; k++) {
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(root, size_keys[k]);
+        if (!v)
+            continue;
+        if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble) || v->valuedouble < 1 || v->valuedouble > SL_SCENE_MAX_SIZE)
+            return sl_err_set(err, SL_ERR_INVALID, "%s must be an integer in [1, %d]", size_keys[k], SL_SCENE_MAX_SIZE);
+        *size_out[k] = (int)v->valuedouble;
+    }
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(root, "background");
+    if (b) {
+        int n = cJSON_IsArray(b) ? cJSON_GetArraySize(b) : 0;
+        if (n != 3 && n != 4)
+            return sl_err_set(err, SL_ERR_INVALID, "background must be [r, g, b] or [r, g, b, a] in 0..1");
+        for (int k = 0; k < n; k++) {
+            const cJSON *e = cJSON_GetArrayItem(b, k);
+            if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0.0 && e->valuedouble <= 1.0))
+                return sl_err_set(err, SL_ERR_INVALID, "background must be [r, g, b] or [r, g, b, a] in 0..1");
+            s->background[k] = (float)e->valuedouble;
+        }
+    }
+    const cJSON *of = cJSON_GetObjectItemCaseSensitive(root, "orbit_frames");
+    if (of) {
+        if (!cJSON_IsNumber(of) || of->valuedouble != floor(of->valuedouble) || of->valuedouble < 0 || of->valuedouble > 1e6)
+            return sl_err_set(err, SL_ERR_INVALID, "orbit_frames must be an integer in [0, 1000000]");
+        s->orbit_frames = (int)of->valuedouble;
+    }
+    s->dataset = cJSON_Duplicate(ds, 1);
+    s->params = params ? cJSON_Duplicate(params, 1) : NULL;
+    if (!s->dataset || (params && !s->params)) {
+        sl_scene_deinit(s);
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    }
+    /* Validate params against the schema now, so errors surface at parse time. */
+    const sl_technique *tech = sl_technique_find(s->technique);
+    sl_params check;
+    sl_params_init(&check, tech->params, tech->param_count);
+    if ((st = sl_params_apply_json(&check, s->params, err)) != SL_OK) {
+        sl_err_prefix(err, "params");
+        sl_scene_deinit(s);
+        return st;
+    }
+    return SL_OK;
+}
+
+sl_status sl_scene_parse(const char *json_text, sl_scene *scene, sl_err *err)
+{
+    memset(scene, 0, sizeof *scene);
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithOpts(json_text, &end, 1);
+    if (!root) {
+        long at = end ? (long)(end - json_text) : 0;
+        return sl_err_set(err, SL_ERR_INVALID, "scene is not valid JSON (near byte %ld)", at);
+    }
+    sl_status st = sl_scene_from_json(root, scene, err);
+    cJSON_Delete(root);
+    return st;
+}
+
+sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *err)
+{
+    const char *eq = strchr(assignment, '=');
+    if (!eq || eq == assignment)
+        return sl_err_set(err, SL_ERR_INVALID, "--set expects key.path=value, got '%.100s'", assignment);
+    size_t key_len = (size_t)(eq - assignment);
+    char key[256];
+    if (key_len >= sizeof key)
+        return sl_err_set(err, SL_ERR_INVALID, "--set key is too long");
+    memcpy(key, assignment, key_len);
+    key[key_len] = '\0';
+    cJSON *value = cJSON_Parse(eq + 1);
+    if (!value)
+        value = cJSON_CreateString(eq + 1);
+    if (!value)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    cJSON *node = root;
+    char *save = NULL;
+    char *part = strtok_r(key, ".", &save);
+    while (part) {
+        char *next = strtok_r(NULL, ".", &save);
+        if (!next) {
+            if (cJSON_GetObjectItemCaseSensitive(node, part))
+                cJSON_ReplaceItemInObjectCaseSensitive(node, part, value);
+            else
+                cJSON_AddItemToObject(node, part, value);
+            /* Orbit and eye/target are alternatives: setting one drops the other. */
+            if (node != root && cJSON_GetObjectItemCaseSensitive(root, "camera") == node) {
+                if (strcmp(part, "orbit") == 0) {
+                    cJSON_DeleteItemFromObjectCaseSensitive(node, "eye");
+                    cJSON_DeleteItemFromObjectCaseSensitive(node, "target");
+                } else if (strcmp(part, "eye") == 0 || strcmp(part, "target") == 0) {
+                    cJSON_DeleteItemFromObjectCaseSensitive(node, "orbit");
+                }
+            }
+            return SL_OK;
+        }
+        cJSON *child = cJSON_GetObjectItemCaseSensitive(node, part);
+        if (!child) {
+            child = cJSON_AddObjectToObject(node, part);
+        } else if (!cJSON_IsObject(child)) {
+            cJSON_Delete(value);
+            return sl_err_set(err, SL_ERR_INVALID, "--set %s: '%s' is not an object", key, part);
+        }
+        if (node == cJSON_GetObjectItemCaseSensitive(root, "camera") && strcmp(part, "orbit") == 0) {
+            cJSON_DeleteItemFromObjectCaseSensitive(node, "eye");
+            cJSON_DeleteItemFromObjectCaseSensitive(node, "target");
+        }
+        node = child;
+        part = next;
+    }
+    cJSON_Delete(value);
+    return sl_err_set(err, SL_ERR_INVALID, "--set expects key.path=value");
+}
+
+sl_status sl_scene_open_dataset(const sl_scene *s, const char *data_dir, sl_dataset **out, sl_err *err)
+{
+    *out = NULL;
+    if (cJSON_IsObject(s->dataset)) {
+        char *text = cJSON_PrintUnformatted(s->dataset);
+        if (!text)
+            return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+        sl_status st = sl_generate_json(text, out, err);
+        free(text);
+        return st;
+    }
+    const char *name = s->dataset->valuestring;
+    const char *builtin = sl_builtin_lookup(name);
+    if (builtin)
+        return sl_generate_json(builtin, out, err);
+    char path[4096];
+    if (name[0] != '/' && data_dir && data_dir[0])
+        snprintf(path, sizeof path, "%s/%s", data_dir, name);
+    else
+        snprintf(path, sizeof path, "%s", name);
+    return sl_load_file(path, out, err);
+}
+
+sl_status sl_scene_view(const sl_scene *s, const sl_dataset *ds, int frame, sl_view *view, sl_err *err)
+{
+    memset(view, 0, sizeof *view);
+    view->width = s->width;
+    view->height = s->height;
+    memcpy(view->background, s->background, sizeof view->background);
+    view->origin = ds->origin;
+    view->quality = SL_QUALITY_STILL;
+    sl_status st;
+    if (s->camera_is_orbit) {
+        sl_orbit o = s->orbit;
+        if (s->orbit_frames > 0)
+            o.azimuth_deg += 360.0 * (double)frame / (double)s->orbit_frames;
+        st = sl_camera_from_orbit(&o, ds->bounds_min, ds->bounds_max, &view->camera, err);
+    } else {
+        view->camera = s->camera;
+        st = sl_camera_validate(&view->camera, err);
+    }
+    if (st != SL_OK)
+        return st;
+    return sl_view_init(view, sl_dataset_radius(ds), err);
+}

@@ -1,0 +1,129 @@
+/* sl_protocol.h — the sightline.v1 wire protocol (proto/PROTOCOL.md): client
+ * message parsing, server message helpers and the binary frame header.
+ *
+ * Parsing checks every field of a client message (type, ranges, unknown
+ * keys) and reports the first bad one by name, so the server can answer with
+ * an `error` naming the field and keep the connection. It does not check
+ * what needs server state (session ids, tokens, technique parameters,
+ * camera geometry): the server does that. Shared by sightline-server, the
+ * server tests and the server benchmark. Any thread; no GL, no sockets.
+ * Invariant: a parsed sl_msg owns its cJSON tree; every cJSON pointer in it
+ * is borrowed from that tree and dies with sl_msg_deinit.
+ */
+#ifndef SL_PROTOCOL_H
+#define SL_PROTOCOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cjson/cJSON.h>
+
+#include "core/sl_status.h"
+
+#define SL_PROTO_VERSION 1
+#define SL_PROTO_SUBPROTOCOL "sightline.v1"
+#define SL_PROTO_MAX_MESSAGE (64 * 1024)        /* bytes of one client message after hello */
+#define SL_PROTO_MAX_HELLO 4096                 /* bytes of a message before hello */
+#define SL_PROTO_ID_MAX 64                      /* session id / token / view name buffers */
+#define SL_PROTO_NAME_MAX 128                   /* dataset and technique names */
+#define SL_PROTO_MAX_SIZE 4096                  /* largest width or height a client may ask */
+#define SL_PROTO_ACK_WINDOW 2                   /* unacknowledged frames a client may have */
+
+typedef enum sl_msg_type {
+    SL_MSG_INVALID = 0,
+    SL_MSG_HELLO,
+    SL_MSG_CAMERA,
+    SL_MSG_SET,
+    SL_MSG_SCENE,
+    SL_MSG_LIST_DATASETS,
+    SL_MSG_LIST_VIEWS,
+    SL_MSG_SAVE_VIEW,
+    SL_MSG_LOAD_VIEW,
+    SL_MSG_RESIZE,
+    SL_MSG_ACK,
+    SL_MSG_SNAPSHOT,
+    SL_MSG_CONTROL,
+    SL_MSG_PING,
+} sl_msg_type;
+
+typedef enum sl_camera_phase {
+    SL_PHASE_NONE = 0,  /* a one-off change: render a still frame now */
+    SL_PHASE_START,
+    SL_PHASE_MOVE,
+    SL_PHASE_END,
+} sl_camera_phase;
+
+typedef enum sl_control_action {
+    SL_CONTROL_REQUEST = 1, /* a viewer asks for control */
+    SL_CONTROL_GRANT,       /* the controller hands control to `client` */
+    SL_CONTROL_RELEASE,     /* the controller gives control up */
+} sl_control_action;
+
+/* One parsed client message. Fields not used by `type` are zero. */
+typedef struct sl_msg {
+    sl_msg_type type;
+    cJSON *root;                      /* owned */
+    int version;                      /* hello */
+    char session[SL_PROTO_ID_MAX];    /* hello: "" = new session */
+    char token[SL_PROTO_ID_MAX];      /* hello */
+    int width, height;                /* hello, resize: 0 = not given */
+    long long seq;                    /* camera, ping */
+    sl_camera_phase phase;            /* camera */
+    const cJSON *camera;              /* camera, scene (optional), borrowed */
+    const cJSON *params;              /* set, scene (optional): object, borrowed */
+    const cJSON *stream;              /* set (optional): object, borrowed */
+    const cJSON *background;          /* set (optional): [r,g,b,a], borrowed */
+    char dataset[SL_PROTO_NAME_MAX];  /* scene: "" = keep */
+    char technique[SL_PROTO_NAME_MAX];/* scene: "" = keep */
+    char name[SL_PROTO_ID_MAX];       /* save_view, load_view */
+    uint32_t frame_id;                /* ack */
+    sl_control_action action;         /* control */
+    int client;                       /* control grant: target client id */
+} sl_msg;
+
+/* Parses one client text message of `len` bytes (need not be NUL-terminated).
+ * On failure returns SL_ERR_INVALID, fills err, writes a stable error code
+ * ("bad_json", "unknown_type", "bad_field") to code and the offending field
+ * name ("" when the whole message is at fault) to field, and leaves *msg
+ * zeroed. code and field are caller buffers of at least 32 and
+ * SL_PROTO_ID_MAX bytes. */
+sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg,
+                       char *code, char *field, sl_err *err);
+void sl_msg_deinit(sl_msg *msg);   /* safe on a zeroed or deinitialized msg */
+
+const char *sl_msg_type_name(sl_msg_type type);
+const char *sl_camera_phase_name(sl_camera_phase phase);
+
+/* {"type":"error","code":code,"message":message,"field":field} as a malloc'd
+ * string (NULL on allocation failure). field may be NULL or "". */
+char *sl_msg_error_text(const char *code, const char *message, const char *field);
+
+/* Binary frames (server -> client): a fixed 40-byte little-endian header
+ * followed by `payload_bytes` bytes of JPEG (kind 0) or PNG (kind 1). */
+#define SL_FRAME_HEADER_SIZE 40
+#define SL_FRAME_MAGIC 0x31464c53u   /* "SLF1" as little-endian u32 */
+
+typedef enum sl_frame_kind { SL_FRAME_JPEG = 0, SL_FRAME_PNG = 1 } sl_frame_kind;
+#define SL_FRAME_FLAG_INTERACTIVE 1u
+
+typedef struct sl_frame_header {
+    uint8_t kind;            /* sl_frame_kind */
+    uint8_t flags;           /* SL_FRAME_FLAG_* */
+    uint32_t frame_id;       /* per session, increasing from 1 */
+    uint32_t state_version;  /* the session state this frame shows */
+    uint16_t width, height;  /* pixels of the encoded image */
+    uint8_t quality;         /* JPEG quality 1..100; 100 for PNG */
+    uint8_t subsampling;     /* 0 = 4:4:4, 1 = 4:2:0 (JPEG), 0 for PNG */
+    float render_ms;         /* wall time of render + readback */
+    float encode_ms;         /* wall time of the encode */
+    uint32_t camera_seq;     /* newest camera `seq` this frame includes */
+    uint32_t payload_bytes;  /* bytes after the header */
+} sl_frame_header;
+
+void sl_frame_header_write(const sl_frame_header *h, uint8_t out[SL_FRAME_HEADER_SIZE]);
+/* Reads a header from a received binary message of `size` bytes; fails
+ * (SL_ERR_FORMAT) on a short buffer, a wrong magic or header size, an unknown
+ * kind, or payload_bytes that disagree with size. */
+sl_status sl_frame_header_read(const uint8_t *data, size_t size, sl_frame_header *h, sl_err *err);
+
+#endif

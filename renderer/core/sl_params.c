@@ -1,0 +1,184 @@
+/* sl_params.c — validation and access of technique parameters (see sl_params.h). */
+#include "sl_params.h"
+
+#include <assert.h>
+#include <math.h>
+#include <string.h>
+
+void sl_params_init(sl_params *p, const sl_param_def *schema, int count)
+{
+    assert(count >= 0 && count <= SL_PARAMS_MAX);
+    memset(p, 0, sizeof *p);
+    p->schema = schema;
+    p->count = count;
+    for (int i = 0; i < count; i++)
+        memcpy(p->value[i], schema[i].def, sizeof p->value[i]);
+}
+
+int sl_params_find(const sl_params *p, const char *name)
+{
+    for (int i = 0; i < p->count; i++)
+        if (strcmp(p->schema[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+static int choice_count(const sl_param_def *d)
+{
+    int n = 0;
+    while (d->choices && d->choices[n])
+        n++;
+    return n;
+}
+
+static sl_status unknown_parameter(const sl_params *p, const char *name, sl_err *err)
+{
+    char known[600] = "";
+    size_t used = 0;
+    for (int i = 0; i < p->count && used + 40 < sizeof known; i++) {
+        size_t len = strlen(p->schema[i].name);
+        if (used + len + 3 >= sizeof known)
+            break;
+        if (i) { memcpy(known + used, ", ", 2); used += 2; }
+        memcpy(known + used, p->schema[i].name, len);
+        used += len;
+        known[used] = '\0';
+    }
+    return sl_err_set(err, SL_ERR_INVALID, "unknown parameter '%s' (known: %s)", name, known);
+}
+
+sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v, int n, sl_err *err)
+{
+    int i = sl_params_find(p, name);
+    if (i < 0)
+        return unknown_parameter(p, name, err);
+    const sl_param_def *d = &p->schema[i];
+    int want = d->type == SL_PARAM_VEC3 ? 3 : 1;
+    if (n != want)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes %d number%s, got %d",
+                          name, sl_param_type_name(d->type), want, want == 1 ? "" : "s", n);
+    for (int k = 0; k < n; k++) {
+        if (!isfinite(v[k]))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a finite number", name);
+        switch (d->type) {
+        case SL_PARAM_BOOL:
+            if (v[k] != 0.0 && v[k] != 1.0)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' is a bool: true or false", name);
+            break;
+        case SL_PARAM_ENUM: {
+            int nc = choice_count(d);
+            if (v[k] != floor(v[k]) || v[k] < 0 || v[k] >= nc)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes a choice index in [0, %d]", name, nc - 1);
+            break;
+        }
+        case SL_PARAM_INT:
+            if (v[k] != floor(v[k]))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer, got %g", name, v[k]);
+            /* fall through */
+        case SL_PARAM_FLOAT:
+        case SL_PARAM_VEC3:
+            if (v[k] < d->min || v[k] > d->max)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' = %g is out of range [%g, %g]%s%s",
+                                  name, v[k], d->min, d->max, d->unit[0] ? " " : "", d->unit);
+            break;
+        }
+    }
+    for (int k = 0; k < n; k++)
+        p->value[i][k] = v[k];
+    return SL_OK;
+}
+
+sl_status sl_params_set_choice(sl_params *p, const char *name, const char *choice, sl_err *err)
+{
+    int i = sl_params_find(p, name);
+    if (i < 0)
+        return unknown_parameter(p, name, err);
+    const sl_param_def *d = &p->schema[i];
+    if (d->type != SL_PARAM_ENUM)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' is a %s, not a choice", name, sl_param_type_name(d->type));
+    char list[400] = "";
+    size_t used = 0;
+    for (int k = 0; d->choices[k]; k++) {
+        if (strcmp(d->choices[k], choice) == 0) {
+            p->value[i][0] = k;
+            return SL_OK;
+        }
+        size_t len = strlen(d->choices[k]);
+        if (used + len + 3 < sizeof list) {
+            if (k) { memcpy(list + used, ", ", 2); used += 2; }
+            memcpy(list + used, d->choices[k], len);
+            used += len;
+            list[used] = '\0';
+        }
+    }
+    return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' has no choice '%.100s' (choices: %s)", name, choice, list);
+}
+
+static int checked_index(const sl_params *p, const char *name, sl_param_type type)
+{
+    int i = sl_params_find(p, name);
+    assert(i >= 0 && "parameter not in schema");
+    assert(i < 0 || p->schema[i].type == type);
+    (void)type;
+    return i;
+}
+
+double sl_params_float(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_FLOAT);
+    return i < 0 ? 0.0 : p->value[i][0];
+}
+
+int sl_params_int(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_INT);
+    return i < 0 ? 0 : (int)p->value[i][0];
+}
+
+bool sl_params_bool(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_BOOL);
+    return i < 0 ? false : p->value[i][0] != 0.0;
+}
+
+int sl_params_choice(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_ENUM);
+    return i < 0 ? 0 : (int)p->value[i][0];
+}
+
+const char *sl_params_choice_name(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_ENUM);
+    return i < 0 ? "" : p->schema[i].choices[(int)p->value[i][0]];
+}
+
+void sl_params_vec3(const sl_params *p, const char *name, float out[3])
+{
+    int i = checked_index(p, name, SL_PARAM_VEC3);
+    for (int k = 0; k < 3; k++)
+        out[k] = i < 0 ? 0.0f : (float)p->value[i][k];
+}
+
+sl_invalidation sl_params_compare(const sl_params *a, const sl_params *b)
+{
+    if (a->schema != b->schema || a->count != b->count)
+        return SL_INVALIDATE_PREPARED;
+    sl_invalidation level = SL_INVALIDATE_NONE;
+    for (int i = 0; i < a->count; i++)
+        if (memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0 && a->schema[i].invalidates > level)
+            level = a->schema[i].invalidates;
+    return level;
+}
+
+const char *sl_param_type_name(sl_param_type t)
+{
+    switch (t) {
+    case SL_PARAM_FLOAT: return "float";
+    case SL_PARAM_INT: return "int";
+    case SL_PARAM_BOOL: return "bool";
+    case SL_PARAM_ENUM: return "enum";
+    case SL_PARAM_VEC3: return "vec3";
+    }
+    return "unknown";
+}

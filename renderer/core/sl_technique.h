@@ -1,0 +1,60 @@
+/* sl_technique.h — the one seam between a rendering technique and everything else.
+ *
+ * A technique is a static table: a name, a parameter schema and three
+ * functions. The server, the CLIs and the benchmarks drive techniques only
+ * through this table (sl_technique_find / sl_technique_list) and never branch
+ * on a name.
+ *
+ *   prepare(gpu, dataset, params) -> state   uploads and preprocessing; kept
+ *                                            across frames
+ *   render(state, view, params, target)      one frame into a bound target
+ *   release(state)                           frees GL objects and memory
+ *
+ * Lifecycle: prepare is called again (after release) only when a parameter
+ * whose schema entry says SL_INVALIDATE_PREPARED (or DATASET) changed, or the
+ * dataset changed — a camera move only calls render. All three run on the
+ * render thread with the GL context current. render sets every piece of GL
+ * state it relies on, draws into the already bound and cleared target
+ * (sl_target_begin: reversed-Z depth, GL_GREATER), writes correct depth for
+ * opaque surfaces, and leaves the target bound. Errors fill err; a failed
+ * prepare leaves *state NULL and nothing allocated.
+ */
+#ifndef SL_TECHNIQUE_H
+#define SL_TECHNIQUE_H
+
+#include <stddef.h>
+
+#include "sl_camera.h"
+#include "sl_params.h"
+#include "sl_status.h"
+
+typedef struct sl_gpu sl_gpu;
+typedef struct sl_dataset sl_dataset;
+typedef struct sl_target sl_target;
+
+/* What a render reports (fill what applies; zero is fine). */
+typedef struct sl_render_stats {
+    double primitives;       /* triangles, boxes or rays issued */
+    double culled;           /* primitives skipped by culling */
+} sl_render_stats;
+
+typedef struct sl_technique {
+    const char *name;
+    const char *description;          /* one line, with the paper where there is one */
+    unsigned dataset_kinds;           /* bit set of sl_dataset_kind it accepts */
+    const sl_param_def *params;
+    int param_count;
+
+    sl_status (*prepare)(sl_gpu *gpu, const sl_dataset *dataset, const sl_params *params,
+                         void **state, sl_err *err);
+    sl_status (*render)(void *state, const sl_view *view, const sl_params *params,
+                        sl_target *target, sl_render_stats *stats, sl_err *err);
+    void (*release)(void *state);     /* NULL state is fine */
+    size_t (*gpu_bytes)(const void *state); /* GPU memory held; may be NULL */
+} sl_technique;
+
+/* The registry (sl_registry.c holds the one table). */
+const sl_technique *sl_technique_find(const char *name);
+const sl_technique *const *sl_technique_list(int *count);
+
+#endif

@@ -1,0 +1,94 @@
+/* sl_gpu.h — headless OpenGL 4.5 core: EGL context, embedded shaders, targets, timers.
+ *
+ * sl_gpu_create picks a hardware GPU through EGL_EXT_platform_device (software
+ * devices skipped), else Mesa's surfaceless platform (llvmpipe);
+ * SIGHTLINE_EGL_DEVICE=software|<index> overrides. The context is current
+ * on the creating thread and every function here, and every technique's
+ * prepare/render/release, must run on that thread (the render thread).
+ * Shaders are .glsl files under renderer/ embedded at build time and named
+ * by their path below renderer/ ("tubes_mesh/tubes_mesh.frag.glsl"); a line
+ * `#include "gpu/glsl/lighting.glsl"` pastes another embedded file, and a
+ * compile error names the file and line. Missing EGL, context or GL feature
+ * is an SL_ERR_GPU with a sentence saying which; never a crash.
+ */
+#ifndef SL_GPU_H
+#define SL_GPU_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <epoxy/gl.h>
+
+#include "../core/sl_status.h"
+
+typedef struct sl_gpu sl_gpu;
+
+typedef struct sl_gpu_desc {
+    const char *device;  /* NULL: $SIGHTLINE_EGL_DEVICE, else auto; "software" or "<index>" */
+    int debug;           /* install a KHR_debug callback that prints GL errors */
+    int quiet;           /* do not print the renderer string */
+} sl_gpu_desc;
+
+sl_status sl_gpu_create(const sl_gpu_desc *desc, sl_gpu **out, sl_err *err);
+void sl_gpu_destroy(sl_gpu *gpu);
+const char *sl_gpu_renderer(const sl_gpu *gpu);  /* GL_RENDERER string */
+int sl_gpu_is_software(const sl_gpu *gpu);
+
+/* Embedded files (generated at build time). */
+typedef struct sl_embedded_file {
+    const char *path;      /* below renderer/ */
+    const char *text;
+    size_t size;
+} sl_embedded_file;
+const sl_embedded_file *sl_embedded_find(const char *path);
+const sl_embedded_file *sl_embedded_list(int *count);
+
+/* Builds a program from embedded shader files; any of the stage names may
+ * be NULL (compute alone, or vertex+fragment, optionally geometry).
+ * `defines` (may be NULL) is pasted after #version, e.g. "#define N 8\n".
+ * Returns 0 and fills err (with the info log, mapped to file:line) on failure. */
+typedef struct sl_program_desc {
+    const char *vertex, *geometry, *fragment, *compute;
+    const char *defines;
+    const char *label;
+} sl_program_desc;
+sl_status sl_gl_program_create(const sl_program_desc *desc, GLuint *program, sl_err *err);
+
+/* An offscreen target: RGBA8 colour + 32F depth (reversed-Z, see sl_camera.h),
+ * optional MSAA resolved into single-sample textures by sl_target_resolve. */
+typedef struct sl_target {
+    int width, height, samples;
+    GLuint fbo, color, depth;             /* render attachments (multisampled when samples > 1) */
+    GLuint resolve_fbo, resolve_color, resolve_depth; /* single-sample; == fbo/color/depth when samples <= 1 */
+} sl_target;
+
+sl_status sl_target_init(sl_target *t, int width, int height, int samples, sl_err *err);
+void sl_target_deinit(sl_target *t);
+/* Binds the target, sets viewport, clip control 0..1 and clears colour to
+ * background and depth to 0 (reversed-Z: nothing hit). */
+void sl_target_begin(sl_target *t, const float background[4]);
+/* Resolves MSAA (no-op without) so readbacks see the final frame. */
+void sl_target_resolve(sl_target *t);
+/* Reads RGBA8; top_down = 1 flips to row 0 at the top, 0 keeps GL's bottom-up rows. */
+void sl_target_read_rgba(sl_target *t, uint8_t *rgba, int top_down);
+/* Reads the depth buffer (reversed-Z values), rows top-down. */
+void sl_target_read_depth(sl_target *t, float *depth);
+
+/* GPU timer (GL_TIME_ELAPSED query). */
+typedef struct sl_gpu_timer { GLuint query; int running; } sl_gpu_timer;
+void sl_gpu_timer_init(sl_gpu_timer *t);
+void sl_gpu_timer_deinit(sl_gpu_timer *t);
+void sl_gpu_timer_begin(sl_gpu_timer *t);
+/* Ends the query and waits for it; returns milliseconds. */
+double sl_gpu_timer_end_ms(sl_gpu_timer *t);
+
+/* The uniform block `sl_camera_block` of gpu/glsl/camera.glsl: creates the
+ * buffer on first use (*buffer == 0), fills it from view and binds it to
+ * uniform binding 0. Delete the buffer with glDeleteBuffers. */
+struct sl_view;
+void sl_camera_ubo_update(GLuint *buffer, const struct sl_view *view);
+
+/* Wall clock in milliseconds (monotonic). */
+double sl_now_ms(void);
+
+#endif

@@ -1,0 +1,213 @@
+/* tubes.c — technique `tubes`: raycast Hermite spline tubes (Russig, Salm, Gumhold,
+ * "GPU-based Raycasting of Hermite Spline Tubes", 3.2).
+ *
+ * prepare turns the line set into Hermite nodes and segments (tubes_nodes.c)
+ * and uploads them once: a node buffer, a colour-scalar buffer and a segment
+ * index buffer. render is one indexed GL_LINES draw: tubes.geom.glsl splits
+ * each segment into two quadratic Beziers and emits their oriented boxes,
+ * tubes.frag.glsl finds the nearest sphere-sweep entry per pixel. A camera
+ * move re-uploads nothing; radius, colour and root-search parameters are
+ * uniforms (an attribute change re-fills the small scalar buffer). Does not
+ * do transparency or level of detail. Render thread only (GL).
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/sl_line_style.h"
+#include "../core/sl_technique.h"
+#include "../data/sl_dataset.h"
+#include "../gpu/sl_gpu.h"
+#include "tubes_nodes.h"
+
+static const char *const root_methods[] = {"bisection", "illinois", NULL};
+static const char *const tangent_modes[] = {"auto", "catmull_rom", "data_exact", NULL};
+
+static const sl_param_def tubes_params[] = {
+    SL_LINE_STYLE_PARAMS,
+    {"iterations", SL_PARAM_INT, 1, 64, {20}, NULL, "",
+     "steps of every root search (the accuracy knob)", SL_INVALIDATE_FRAME},
+    {"root_method", SL_PARAM_ENUM, 0, 0, {1}, root_methods, "",
+     "root search: bisection (as in the paper) or Illinois regula falsi (default: same error in fewer steps)",
+     SL_INVALIDATE_FRAME},
+    {"tangents", SL_PARAM_ENUM, 0, 0, {0}, tangent_modes, "",
+     "node tangents: auto (explicit Hermite data exactly, data tangent directions with Catmull-Rom length, else Catmull-Rom), catmull_rom, or the data's as they are", SL_INVALIDATE_PREPARED},
+    {"frustum_culling", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
+     "skip boxes outside the view frustum in the geometry shader", SL_INVALIDATE_FRAME},
+    {"silhouette_only", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
+     "discard every fragment (measures the silhouette cost; draws nothing)", SL_INVALIDATE_FRAME},
+};
+
+typedef struct tubes_state {
+    const sl_dataset *dataset;   /* borrowed */
+    sl_tubes_nodes nodes;        /* CPU copy of the colour scalars (geometry freed after upload) */
+    GLuint program, program_silhouette;
+    GLuint vao, node_vbo, color_vbo, ibo, colormap_tex, camera_ubo, query;
+    int colormap_loaded;         /* colormap index in colormap_tex, or -1 */
+    int attribute_loaded;        /* attribute in color_vbo, or -2 */
+    size_t gpu_bytes;
+} tubes_state;
+
+static void tubes_release(void *opaque)
+{
+    tubes_state *s = opaque;
+    if (!s)
+        return;
+    if (s->program) glDeleteProgram(s->program);
+    if (s->program_silhouette) glDeleteProgram(s->program_silhouette);
+    if (s->vao) glDeleteVertexArrays(1, &s->vao);
+    if (s->node_vbo) glDeleteBuffers(1, &s->node_vbo);
+    if (s->color_vbo) glDeleteBuffers(1, &s->color_vbo);
+    if (s->ibo) glDeleteBuffers(1, &s->ibo);
+    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
+    if (s->query) glDeleteQueries(1, &s->query);
+    sl_tubes_nodes_deinit(&s->nodes);
+    free(s);
+}
+
+static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out, sl_err *err)
+{
+    (void)gpu;
+    *out = NULL;
+    if (ds->kind != SL_DATASET_LINES)
+        return sl_err_set(err, SL_ERR_INVALID, "tubes renders line sets, not %s datasets", sl_dataset_kind_name(ds->kind));
+    tubes_state *s = calloc(1, sizeof *s);
+    if (!s)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    s->dataset = ds;
+    s->colormap_loaded = -1;
+    s->attribute_loaded = -2;
+    sl_status st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1,
+                                        &s->nodes, err);
+    if (st != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
+                                                      .geometry = "tubes/tubes.geom.glsl",
+                                                      .fragment = "tubes/tubes.frag.glsl",
+                                                      .label = "tubes"},
+                                   &s->program, err)) != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
+                                                      .geometry = "tubes/tubes.geom.glsl",
+                                                      .fragment = "tubes/tubes_silhouette.frag.glsl",
+                                                      .label = "tubes_silhouette"},
+                                   &s->program_silhouette, err)) != SL_OK)
+        goto fail;
+
+    size_t nn = s->nodes.node_count ? s->nodes.node_count : 1;
+    size_t ns = s->nodes.segment_count ? s->nodes.segment_count : 1;
+    glCreateBuffers(1, &s->node_vbo);
+    glNamedBufferStorage(s->node_vbo, (GLsizeiptr)(nn * SL_TUBES_NODE_FLOATS * sizeof(float)),
+                         s->nodes.node_count ? s->nodes.geometry : NULL, 0);
+    glCreateBuffers(1, &s->color_vbo);
+    glNamedBufferStorage(s->color_vbo, (GLsizeiptr)(nn * 2 * sizeof(float)), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glCreateBuffers(1, &s->ibo);
+    glNamedBufferStorage(s->ibo, (GLsizeiptr)(ns * 2 * sizeof(uint32_t)),
+                         s->nodes.segment_count ? s->nodes.segments : NULL, 0);
+    glCreateVertexArrays(1, &s->vao);
+    glVertexArrayVertexBuffer(s->vao, 0, s->node_vbo, 0, SL_TUBES_NODE_FLOATS * sizeof(float));
+    glVertexArrayVertexBuffer(s->vao, 1, s->color_vbo, 0, 2 * sizeof(float));
+    glVertexArrayElementBuffer(s->vao, s->ibo);
+    for (GLuint a = 0; a < 3; a++)
+        glEnableVertexArrayAttrib(s->vao, a);
+    glVertexArrayAttribFormat(s->vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribFormat(s->vao, 1, 4, GL_FLOAT, GL_FALSE, 4 * sizeof(float));
+    glVertexArrayAttribFormat(s->vao, 2, 2, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(s->vao, 0, 0);
+    glVertexArrayAttribBinding(s->vao, 1, 0);
+    glVertexArrayAttribBinding(s->vao, 2, 1);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
+    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glGenQueries(1, &s->query);
+    s->gpu_bytes = nn * (SL_TUBES_NODE_FLOATS + 2) * sizeof(float) + ns * 2 * sizeof(uint32_t) +
+                   SL_COLORMAP_TEXELS * 4;
+    /* The geometry lives on the GPU now; keep only the colour scalars. */
+    free(s->nodes.geometry);
+    s->nodes.geometry = NULL;
+    free(s->nodes.segments);
+    s->nodes.segments = NULL;
+    *out = s;
+    return SL_OK;
+fail:
+    tubes_release(s);
+    return st;
+}
+
+static void set_uniforms(GLuint program, const sl_line_style *style, const sl_params *params, int data_radii)
+{
+    glUseProgram(program);
+    glUniform1f(glGetUniformLocation(program, "u_radius"), style->radius);
+    glUniform1f(glGetUniformLocation(program, "u_radius_scale"), style->radius_scale);
+    glUniform1i(glGetUniformLocation(program, "u_data_radii"), data_radii);
+    glUniform1i(glGetUniformLocation(program, "u_frustum_cull"), sl_params_bool(params, "frustum_culling"));
+    glUniform1i(glGetUniformLocation(program, "u_iterations"), sl_params_int(params, "iterations"));
+    glUniform1i(glGetUniformLocation(program, "u_method"), sl_params_choice(params, "root_method"));
+    glUniform2fv(glGetUniformLocation(program, "u_scalar_range"), 1, style->scalar_range);
+    glUniform1i(glGetUniformLocation(program, "u_use_colormap"), style->attribute >= 0);
+    glUniform3fv(glGetUniformLocation(program, "u_color"), 1, style->color);
+    glUniform3fv(glGetUniformLocation(program, "u_light_eye"), 1, style->light_direction);
+    glUniform4fv(glGetUniformLocation(program, "u_material"), 1, style->material);
+    glUniform1i(glGetUniformLocation(program, "u_colormap"), 0);
+}
+
+static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
+                              sl_render_stats *stats, sl_err *err)
+{
+    (void)target; (void)err;
+    tubes_state *s = opaque;
+    sl_line_style style;
+    sl_line_style_read(params, s->dataset, &style);
+    if (style.colormap != s->colormap_loaded) {
+        uint8_t table[SL_COLORMAP_TEXELS * 4];
+        sl_colormap_table(style.colormap, table);
+        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
+        s->colormap_loaded = style.colormap;
+    }
+    if (style.attribute != s->attribute_loaded) {
+        sl_tubes_nodes_set_color(&s->dataset->lines, style.attribute, &s->nodes);
+        if (s->nodes.node_count)
+            glNamedBufferSubData(s->color_vbo, 0, (GLsizeiptr)(s->nodes.node_count * 2 * sizeof(float)),
+                                 s->nodes.color);
+        s->attribute_loaded = style.attribute;
+    }
+    sl_camera_ubo_update(&s->camera_ubo, view);
+    GLuint program = sl_params_bool(params, "silhouette_only") ? s->program_silhouette : s->program;
+    set_uniforms(program, &style, params, s->nodes.has_radii);
+    glBindTextureUnit(0, s->colormap_tex);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE); /* the geometry shader emits only faces towards the eye */
+    glBindVertexArray(s->vao);
+    glBeginQuery(GL_PRIMITIVES_GENERATED, s->query);
+    glDrawElements(GL_LINES, (GLsizei)(2 * s->nodes.segment_count), GL_UNSIGNED_INT, NULL);
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    glBindVertexArray(0);
+    GLuint triangles = 0;
+    glGetQueryObjectuiv(s->query, GL_QUERY_RESULT, &triangles);
+    stats->primitives = (double)triangles;                       /* triangles rasterized (2 per face) */
+    stats->culled = 0.0;
+    return SL_OK;
+}
+
+static size_t tubes_gpu_bytes(const void *opaque)
+{
+    const tubes_state *s = opaque;
+    return s ? s->gpu_bytes : 0;
+}
+
+const sl_technique sl_tubes_technique = {
+    .name = "tubes",
+    .description = "raycast Hermite spline tubes (Russig, Salm, Gumhold: GPU-based Raycasting of Hermite Spline Tubes)",
+    .dataset_kinds = SL_DATASET_LINES,
+    .params = tubes_params,
+    .param_count = (int)(sizeof tubes_params / sizeof tubes_params[0]),
+    .prepare = tubes_prepare,
+    .render = tubes_render,
+    .release = tubes_release,
+    .gpu_bytes = tubes_gpu_bytes,
+};

@@ -1,0 +1,175 @@
+/* tubes_mesh.c — technique `tubes_mesh`: rasterized tubes swept along polylines.
+ *
+ * The tessellation baseline of the spline-tube (Russig et al.) and voxel-line
+ * (Kanzler et al.) papers, and the first thing a user sees. prepare builds
+ * the mesh on the CPU (tubes_mesh_build.c) and uploads it once; the radius
+ * and every shading parameter are uniforms, so only `sides` and `caps`
+ * re-prepare. One indexed draw per frame. Render thread only.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/sl_line_style.h"
+#include "../core/sl_technique.h"
+#include "../data/sl_dataset.h"
+#include "../gpu/sl_gpu.h"
+#include "tubes_mesh_build.h"
+
+static const sl_param_def tubes_mesh_params[] = {
+    SL_LINE_STYLE_PARAMS,
+    {"sides", SL_PARAM_INT, 6, 30, {12}, NULL, "", "vertices per cross-section", SL_INVALIDATE_PREPARED},
+    {"caps", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "close tube ends with flat caps", SL_INVALIDATE_PREPARED},
+};
+
+typedef struct tubes_mesh_state {
+    const sl_dataset *dataset;  /* borrowed */
+    GLuint program, vao, vbo, ibo, colormap_tex, camera_ubo;
+    GLuint scalars;             /* SSBO: the chosen attribute's per-vertex values */
+    int colormap_loaded;        /* colormap index in colormap_tex, or -1 */
+    int attribute_loaded;       /* attribute index in `scalars`, or -2 */
+    GLsizei index_count;
+    size_t gpu_bytes;
+    size_t triangles;
+} tubes_mesh_state;
+
+static void tubes_mesh_release(void *opaque)
+{
+    tubes_mesh_state *s = opaque;
+    if (!s)
+        return;
+    if (s->program) glDeleteProgram(s->program);
+    if (s->vao) glDeleteVertexArrays(1, &s->vao);
+    if (s->vbo) glDeleteBuffers(1, &s->vbo);
+    if (s->ibo) glDeleteBuffers(1, &s->ibo);
+    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
+    if (s->scalars) glDeleteBuffers(1, &s->scalars);
+    free(s);
+}
+
+static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params,
+                                    void **out, sl_err *err)
+{
+    (void)gpu;
+    *out = NULL;
+    tubes_mesh_state *s = calloc(1, sizeof *s);
+    if (!s)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    s->dataset = ds;
+    s->colormap_loaded = -1;
+    s->attribute_loaded = -2;
+    sl_tube_mesh mesh;
+    sl_status st = sl_tube_mesh_build(&ds->lines, sl_params_int(params, "sides"),
+                                      sl_params_bool(params, "caps"), &mesh, err);
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
+    st = sl_gl_program_create(&(sl_program_desc){
+        .vertex = "tubes_mesh/tubes_mesh.vert.glsl",
+        .fragment = "tubes_mesh/tubes_mesh.frag.glsl",
+        .label = "tubes_mesh"}, &s->program, err);
+    if (st != SL_OK) {
+        sl_tube_mesh_deinit(&mesh);
+        tubes_mesh_release(s);
+        return st;
+    }
+    glCreateBuffers(1, &s->vbo);
+    /* Empty meshes still get a (1-element) buffer so the VAO is complete. */
+    glNamedBufferStorage(s->vbo, (GLsizeiptr)((mesh.vertex_count ? mesh.vertex_count : 1) * sizeof(sl_tube_vertex)),
+                         mesh.vertex_count ? mesh.vertices : NULL, 0);
+    glCreateBuffers(1, &s->ibo);
+    glNamedBufferStorage(s->ibo, (GLsizeiptr)((mesh.index_count ? mesh.index_count : 1) * sizeof(uint32_t)),
+                         mesh.index_count ? mesh.indices : NULL, 0);
+    glCreateVertexArrays(1, &s->vao);
+    glVertexArrayVertexBuffer(s->vao, 0, s->vbo, 0, sizeof(sl_tube_vertex));
+    glVertexArrayElementBuffer(s->vao, s->ibo);
+    const GLuint offsets[5] = {offsetof(sl_tube_vertex, centre), offsetof(sl_tube_vertex, offset),
+                               offsetof(sl_tube_vertex, normal), offsetof(sl_tube_vertex, radius),
+                               offsetof(sl_tube_vertex, source)};
+    const GLint sizes[5] = {3, 3, 3, 1, 1};
+    for (GLuint a = 0; a < 5; a++) {
+        glEnableVertexArrayAttrib(s->vao, a);
+        if (a == 4)
+            glVertexArrayAttribIFormat(s->vao, a, 1, GL_UNSIGNED_INT, offsets[a]);
+        else
+            glVertexArrayAttribFormat(s->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+        glVertexArrayAttribBinding(s->vao, a, 0);
+    }
+    glCreateBuffers(1, &s->scalars);
+    glNamedBufferStorage(s->scalars, (GLsizeiptr)((ds->lines.vertex_count + 1) * sizeof(float)), NULL,
+                         GL_DYNAMIC_STORAGE_BIT);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
+    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    s->index_count = (GLsizei)mesh.index_count;
+    s->triangles = mesh.index_count / 3;
+    s->gpu_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t) +
+                   (ds->lines.vertex_count + 1) * sizeof(float) + SL_COLORMAP_TEXELS * 4;
+    sl_tube_mesh_deinit(&mesh);
+    *out = s;
+    return SL_OK;
+}
+
+static sl_status tubes_mesh_render(void *opaque, const sl_view *view, const sl_params *params,
+                                   sl_target *target, sl_render_stats *stats, sl_err *err)
+{
+    (void)target; (void)err;
+    tubes_mesh_state *s = opaque;
+    sl_line_style style;
+    sl_line_style_read(params, s->dataset, &style);
+    if (style.colormap != s->colormap_loaded) {
+        uint8_t table[SL_COLORMAP_TEXELS * 4];
+        sl_colormap_table(style.colormap, table);
+        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
+        s->colormap_loaded = style.colormap;
+    }
+    if (style.attribute != s->attribute_loaded) {
+        if (style.attribute >= 0 && s->dataset->lines.vertex_count > 0)
+            glNamedBufferSubData(s->scalars, 0, (GLsizeiptr)(s->dataset->lines.vertex_count * sizeof(float)),
+                                 s->dataset->lines.attributes[style.attribute].values);
+        s->attribute_loaded = style.attribute;
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->scalars);
+    sl_camera_ubo_update(&s->camera_ubo, view);
+    glUseProgram(s->program);
+    glUniform1f(glGetUniformLocation(s->program, "u_radius"), style.radius);
+    glUniform1f(glGetUniformLocation(s->program, "u_radius_scale"), style.radius_scale);
+    glUniform2fv(glGetUniformLocation(s->program, "u_scalar_range"), 1, style.scalar_range);
+    glUniform1i(glGetUniformLocation(s->program, "u_use_colormap"), style.attribute >= 0);
+    glUniform3fv(glGetUniformLocation(s->program, "u_color"), 1, style.color);
+    glUniform3fv(glGetUniformLocation(s->program, "u_light_eye"), 1, style.light_direction);
+    glUniform4fv(glGetUniformLocation(s->program, "u_material"), 1, style.material);
+    glUniform1i(glGetUniformLocation(s->program, "u_colormap"), 0);
+    glBindTextureUnit(0, s->colormap_tex);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE); /* caps and mantles are seen from inside too */
+    glBindVertexArray(s->vao);
+    glDrawElements(GL_TRIANGLES, s->index_count, GL_UNSIGNED_INT, NULL);
+    glBindVertexArray(0);
+    stats->primitives = (double)s->triangles;
+    return SL_OK;
+}
+
+static size_t tubes_mesh_gpu_bytes(const void *opaque)
+{
+    const tubes_mesh_state *s = opaque;
+    return s ? s->gpu_bytes : 0;
+}
+
+const sl_technique sl_tubes_mesh_technique = {
+    .name = "tubes_mesh",
+    .description = "rasterized tubes swept along polylines (tessellation baseline)",
+    .dataset_kinds = SL_DATASET_LINES,
+    .params = tubes_mesh_params,
+    .param_count = (int)(sizeof tubes_mesh_params / sizeof tubes_mesh_params[0]),
+    .prepare = tubes_mesh_prepare,
+    .render = tubes_mesh_render,
+    .release = tubes_mesh_release,
+    .gpu_bytes = tubes_mesh_gpu_bytes,
+};

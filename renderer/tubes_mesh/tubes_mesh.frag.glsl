@@ -1,0 +1,28 @@
+// tubes_mesh.frag.glsl — Lambert + Blinn-Phong shading of the tessellated tubes,
+// coloured through a colormap on a scalar (or a constant colour).
+#include "gpu/glsl/camera.glsl"
+#include "gpu/glsl/lighting.glsl"
+#include "gpu/glsl/colormap.glsl"
+
+in vec3 v_position;
+in vec3 v_normal;
+in float v_scalar;
+
+uniform sampler2D u_colormap;
+uniform vec2 u_scalar_range;
+uniform int u_use_colormap;
+uniform vec3 u_color;
+uniform vec3 u_light_eye;        // direction to the light in eye space (x right, y up, z to viewer)
+uniform vec4 u_material;         // ambient, diffuse, specular, shininess
+
+layout(location = 0) out vec4 o_color;
+
+void main()
+{
+    vec3 base = u_use_colormap != 0 ? sl_colormap(u_colormap, v_scalar, u_scalar_range) : u_color;
+    vec3 l = normalize(u_light_eye.x * sl_right.xyz + u_light_eye.y * sl_up.xyz - u_light_eye.z * sl_forward.xyz);
+    vec3 v = normalize(sl_eye.xyz - v_position);
+    vec3 n = normalize(v_normal);
+    sl_material m = sl_material(u_material.x, u_material.y, u_material.z, u_material.w);
+    o_color = vec4(sl_shade(base, n, l, v, m), 1.0);
+}

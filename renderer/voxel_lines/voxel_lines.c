@@ -1,0 +1,509 @@
+/* voxel_lines.c — technique `voxel_lines`: voxel-based ray casting of large
+ * line sets (Kanzler, Rautenhaus, Westermann, "A Voxel-based Rendering
+ * Pipeline for Large 3D Line Sets", TVCG 2018).
+ *
+ * prepare voxelizes on the CPU (voxelize_cpu.c: exact clipping, face
+ * quantization, bit packing, 5-byte headers) and uploads headers, lines and
+ * the per-voxel density with its mip chain (the density LoD). render casts
+ * one ray per pixel in a full-screen fragment pass (voxel_lines.frag.glsl).
+ * A camera move only renders; radius, opacity and shading are uniforms; AO
+ * is recomputed (compute shader) only when it is on and opacity, radius or
+ * its own parameters changed; the attribute byte is rebuilt when the colour
+ * attribute changes. Grid resolution, quantization and the per-voxel cap
+ * re-prepare. Data radii are not used (one radius for all tubes). Lines
+ * dropped by the per-voxel cap are reported once per build on stderr.
+ * Render thread only. Limits: README.md.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/sl_line_style.h"
+#include "../core/sl_technique.h"
+#include "../data/sl_dataset.h"
+#include "../gpu/sl_gpu.h"
+#include "voxel_gpu.h"
+#include "voxel_grid.h"
+#include "voxel_lod.h"
+
+static const char *const quant_choices[] = {"2", "4", "8", "16", "32", "64", "128", "256", NULL};
+static const char *const neighbor_choices[] = {"auto", "own", "always", NULL};
+static const char *const build_choices[] = {"cpu", "gpu", NULL};
+static const char *const shadow_choices[] = {"soft", "lines", NULL};
+static const char *const opacity_tf_choices[] = {"constant", "ramp", NULL};
+
+static const sl_param_def voxel_lines_params[] = {
+    SL_LINE_STYLE_PARAMS,
+    {"opacity", SL_PARAM_FLOAT, 0.0, 1.0, {1.0}, NULL, "", "per-line opacity; 1 = opaque (first hit ends the ray)",
+     SL_INVALIDATE_FRAME},
+    {"opacity_transfer", SL_PARAM_ENUM, 0, 0, {0}, opacity_tf_choices, "",
+     "constant: every line has `opacity`; ramp: opacity x the line's colormap coordinate (attribute through "
+     "scalar_min..scalar_max, clamped to 0..1)", SL_INVALIDATE_FRAME},
+    {"grid", SL_PARAM_INT, 0, 512, {0}, NULL, "voxels",
+     "voxels along the longest side; 0 = automatic (about two segment lengths per voxel, 32..256)",
+     SL_INVALIDATE_PREPARED},
+    {"quantization", SL_PARAM_ENUM, 0, 0, {4}, quant_choices, "bins",
+     "face subdivision N (N x N bins per voxel face)", SL_INVALIDATE_PREPARED},
+    {"voxelize", SL_PARAM_ENUM, 0, 0, {0}, build_choices, "",
+     "where to voxelize: cpu, or gpu (compute shaders; without an attribute byte, so a colour attribute "
+     "falls back to cpu)", SL_INVALIDATE_PREPARED},
+    {"max_lines_per_voxel", SL_PARAM_INT, 1, 255, {255}, NULL, "",
+     "cap per voxel (the header count is 8 bits); further lines are dropped and counted", SL_INVALIDATE_PREPARED},
+    {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {0.99}, NULL, "", "early ray termination at this opacity",
+     SL_INVALIDATE_FRAME},
+    {"opacity_by_distance", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
+     "scale opacity by the distance travelled inside the tube (opacity per diameter)", SL_INVALIDATE_FRAME},
+    {"neighbors", SL_PARAM_ENUM, 0, 0, {0}, neighbor_choices, "",
+     "test neighbouring voxels' lines: auto = only for still frames, own = never, always", SL_INVALIDATE_FRAME},
+    {"empty_space_skipping", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
+     "skip blocks of up to 8^3 voxels with no line within 2 voxels (occupancy pyramid)", SL_INVALIDATE_FRAME},
+    {"shadows", SL_PARAM_BOOL, 0, 1, {0}, NULL, "", "soft shadows from the density LoD", SL_INVALIDATE_FRAME},
+    {"shadow_strength", SL_PARAM_FLOAT, 0.0, 1.0, {0.7}, NULL, "", "how dark full shadow is", SL_INVALIDATE_FRAME},
+    {"shadow_mode", SL_PARAM_ENUM, 0, 0, {0}, shadow_choices, "",
+     "soft: density cone tracing; lines: hard shadows from representative lines at level max(1, shadow_lod)",
+     SL_INVALIDATE_FRAME},
+    {"shadow_lod", SL_PARAM_INT, 0, 4, {0}, NULL, "level", "finest density level the shadow cone samples",
+     SL_INVALIDATE_FRAME},
+    {"ao", SL_PARAM_BOOL, 0, 1, {0}, NULL, "", "ambient occlusion from the density field", SL_INVALIDATE_FRAME},
+    {"ao_strength", SL_PARAM_FLOAT, 0.0, 1.0, {0.6}, NULL, "", "weight of ambient occlusion", SL_INVALIDATE_FRAME},
+    {"ao_rays", SL_PARAM_INT, 4, 256, {64}, NULL, "", "rays per AO cell", SL_INVALIDATE_FRAME},
+    {"ao_radius", SL_PARAM_FLOAT, 1.0, 16.0, {5.0}, NULL, "voxels", "AO radius of influence", SL_INVALIDATE_FRAME},
+};
+
+typedef struct voxel_lines_state {
+    const sl_dataset *dataset;  /* borrowed */
+    sl_voxel_frame frame;
+    int resolution;             /* the `grid` parameter (0 = automatic) */
+    int use_gpu;                /* voxelize with compute shaders when no attribute is used */
+    int quant, quant_bits, line_bits, max_per_voxel;
+    int built_attribute;        /* attribute index of the uploaded attribute bytes, or -1 */
+    size_t voxel_count, line_count, grid_bytes;
+    double build_ms;
+    size_t dropped_overflow, capped_voxels;
+    GLuint program, ao_program, vao, camera_ubo, colormap_tex;
+    GLuint offsets_buf, counts_buf, lines_buf, density_tex, ao_tex, occupancy_tex, reps_buf;
+    int rep_levels, rep_dims[SL_VOXEL_LOD_MAX_LEVELS][3], rep_base[SL_VOXEL_LOD_MAX_LEVELS];
+    int occupancy_levels;
+    int colormap_loaded;
+    int ready;                  /* 1 when every grid buffer is uploaded */
+    int ao_dims[3];
+    int ao_valid;
+    float ao_key[4];            /* extinction, rays, radius, valid */
+    int density_levels;
+} voxel_lines_state;
+
+static void release_grid(voxel_lines_state *s)
+{
+    GLuint bufs[4] = {s->offsets_buf, s->counts_buf, s->lines_buf, s->reps_buf};
+    for (int i = 0; i < 4; i++)
+        if (bufs[i])
+            glDeleteBuffers(1, &bufs[i]);
+    if (s->density_tex) glDeleteTextures(1, &s->density_tex);
+    if (s->ao_tex) glDeleteTextures(1, &s->ao_tex);
+    if (s->occupancy_tex) glDeleteTextures(1, &s->occupancy_tex);
+    s->offsets_buf = s->counts_buf = s->lines_buf = s->density_tex = s->ao_tex = s->occupancy_tex = 0;
+    s->reps_buf = 0;
+    s->rep_levels = 0;
+    s->ao_valid = 0;
+    s->ready = 0;
+}
+
+static void voxel_lines_release(void *opaque)
+{
+    voxel_lines_state *s = opaque;
+    if (!s)
+        return;
+    release_grid(s);
+    if (s->program) glDeleteProgram(s->program);
+    if (s->ao_program) glDeleteProgram(s->ao_program);
+    if (s->vao) glDeleteVertexArrays(1, &s->vao);
+    if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
+    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    free(s);
+}
+
+static GLuint make_buffer(const void *data, size_t bytes)
+{
+    GLuint b;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, (GLsizeiptr)(bytes ? bytes : 4), bytes ? data : NULL, 0);
+    return b;
+}
+
+/* The occupancy pyramid for empty-space skipping: level 0 is 1 where a voxel
+ * within 2 (Chebyshev) holds lines — so tubes of radius <= 2 voxels and the
+ * neighbour search never reach a 0 voxel — and level L is the max over 2^3
+ * cells of level L-1. Computed on the CPU from the counts (separable max). */
+static sl_status upload_occupancy(voxel_lines_state *s, const uint8_t *counts, sl_err *err)
+{
+    const int *dm = s->frame.dims;
+    size_t n = s->voxel_count;
+    uint8_t *a = malloc(n), *b = malloc(n);
+    if (!a || !b) {
+        free(a);
+        free(b);
+        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines: out of memory for the occupancy of %zu voxels", n);
+    }
+    for (size_t v = 0; v < n; v++)
+        a[v] = counts[v] != 0;
+    size_t stride[3] = {1, (size_t)dm[0], (size_t)dm[0] * dm[1]};
+    for (int ax = 0; ax < 3; ax++) {
+        for (size_t v = 0; v < n; v++) {
+            int c = (int)(v / stride[ax] % (size_t)dm[ax]);
+            uint8_t m = 0;
+            for (int k = -2; k <= 2; k++)
+                if (c + k >= 0 && c + k < dm[ax])
+                    m |= a[(size_t)((ptrdiff_t)v + (ptrdiff_t)k * (ptrdiff_t)stride[ax])];
+            b[v] = m;
+        }
+        uint8_t *t = a; a = b; b = t;
+    }
+    s->occupancy_levels = 4;
+    glCreateTextures(GL_TEXTURE_3D, 1, &s->occupancy_tex);
+    glTextureStorage3D(s->occupancy_tex, s->occupancy_levels, GL_R8UI, dm[0], dm[1], dm[2]);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    int w[3] = {dm[0], dm[1], dm[2]};
+    for (int level = 0; level < s->occupancy_levels; level++) {
+        glTextureSubImage3D(s->occupancy_tex, level, 0, 0, 0, w[0], w[1], w[2], GL_RED_INTEGER, GL_UNSIGNED_BYTE, a);
+        /* Level sizes follow GL: max(1, floor(w / 2)); cells beyond are folded in by the max. */
+        int gw[3];
+        for (int c = 0; c < 3; c++)
+            gw[c] = w[c] / 2 > 1 ? w[c] / 2 : 1;
+        memset(b, 0, (size_t)gw[0] * gw[1] * gw[2]);
+        for (int z = 0; z < w[2]; z++)
+            for (int y = 0; y < w[1]; y++)
+                for (int x = 0; x < w[0]; x++) {
+                    int X = x / 2 < gw[0] ? x / 2 : gw[0] - 1, Y = y / 2 < gw[1] ? y / 2 : gw[1] - 1,
+                        Z = z / 2 < gw[2] ? z / 2 : gw[2] - 1;
+                    b[(size_t)X + (size_t)gw[0] * ((size_t)Y + (size_t)gw[1] * Z)] |=
+                        a[(size_t)x + (size_t)w[0] * ((size_t)y + (size_t)w[1] * z)];
+                }
+        uint8_t *t = a; a = b; b = t;
+        memcpy(w, gw, sizeof w);
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureParameteri(s->occupancy_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    glTextureParameteri(s->occupancy_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    free(a);
+    free(b);
+    return SL_OK;
+}
+
+/* Representative lines of levels 1..4 (level 0 would cost 24 bytes per
+ * voxel) in one buffer; level L starts at rep_base[L] floats. */
+static sl_status upload_representatives(voxel_lines_state *s, const sl_voxel_grid *g, sl_err *err)
+{
+    sl_voxel_lod lod;
+    sl_status st = sl_voxel_lod_build(g, SL_VOXEL_LOD_MAX_LEVELS, &lod, err);
+    if (st != SL_OK)
+        return st;
+    size_t total = 0;
+    for (int L = 1; L < lod.levels; L++) {
+        s->rep_base[L] = (int)total;
+        memcpy(s->rep_dims[L], lod.level[L].dims, sizeof s->rep_dims[L]);
+        total += 6u * (size_t)lod.level[L].dims[0] * lod.level[L].dims[1] * lod.level[L].dims[2];
+    }
+    float *all = malloc((total ? total : 1) * sizeof *all);
+    if (!all) {
+        sl_voxel_lod_deinit(&lod);
+        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines: out of memory for representative lines");
+    }
+    for (int L = 1; L < lod.levels; L++)
+        memcpy(all + s->rep_base[L], lod.level[L].lines,
+               6u * sizeof(float) * (size_t)lod.level[L].dims[0] * lod.level[L].dims[1] * lod.level[L].dims[2]);
+    s->rep_levels = lod.levels;
+    s->reps_buf = make_buffer(all, total * sizeof *all);
+    s->grid_bytes += total * sizeof *all;
+    free(all);
+    sl_voxel_lod_deinit(&lod);
+    return SL_OK;
+}
+
+/* Voxelizes with the given attribute and uploads; replaces any previous grid. */
+static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *err)
+{
+    sl_voxel_grid g;
+    sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = 1,
+                               .max_per_voxel = s->max_per_voxel, .attribute = attribute};
+    sl_status st = s->use_gpu && attribute < 0 ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
+                                               : sl_voxel_grid_build(&g, s->dataset, &desc, err);
+    if (st != SL_OK)
+        return st;
+    release_grid(s);
+    s->frame = g.frame;
+    s->quant_bits = g.quant_bits;
+    s->line_bits = 8 * g.line_bytes;
+    s->voxel_count = g.voxel_count;
+    s->line_count = g.line_count;
+    s->build_ms = g.build_ms;
+    s->dropped_overflow = g.dropped_overflow;
+    s->capped_voxels = g.capped_voxels;
+    s->built_attribute = g.attribute_index;
+    s->grid_bytes = sl_voxel_grid_bytes(&g);
+
+    size_t count_words = (g.voxel_count + 3) / 4;
+    uint32_t *packed = calloc(count_words ? count_words : 1, sizeof *packed);
+    size_t line_bytes = g.line_count * (size_t)g.line_bytes + 8;
+    size_t line_words = (line_bytes + 3) / 4;
+    uint32_t *words = calloc(line_words, sizeof *words);
+    if (!packed || !words) {
+        free(packed);
+        free(words);
+        sl_voxel_grid_deinit(&g);
+        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines: out of memory packing %zu voxels", g.voxel_count);
+    }
+    for (size_t v = 0; v < g.voxel_count; v++)
+        packed[v / 4] |= (uint32_t)g.counts[v] << (8 * (v % 4));
+    memcpy(words, g.lines, g.line_count * (size_t)g.line_bytes);
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    size_t biggest = line_words * sizeof(uint32_t) > g.voxel_count * sizeof(uint32_t)
+                         ? line_words * sizeof(uint32_t) : g.voxel_count * sizeof(uint32_t);
+    if (max_block > 0 && biggest > (size_t)max_block) {
+        free(packed);
+        free(words);
+        sl_voxel_grid_deinit(&g);
+        return sl_err_set(err, SL_ERR_LIMIT,
+                          "voxel_lines: a %zu-byte buffer exceeds the GPU's shader storage block limit of %lld bytes; "
+                          "lower `grid` or `quantization`", biggest, (long long)max_block);
+    }
+    s->offsets_buf = make_buffer(g.offsets, g.voxel_count * sizeof(uint32_t));
+    s->counts_buf = make_buffer(packed, count_words * sizeof(uint32_t));
+    s->lines_buf = make_buffer(words, line_words * sizeof(uint32_t));
+    free(packed);
+    free(words);
+
+    int maxdim = g.frame.dims[0];
+    for (int c = 1; c < 3; c++)
+        if (g.frame.dims[c] > maxdim)
+            maxdim = g.frame.dims[c];
+    s->density_levels = 1;
+    while ((1 << s->density_levels) <= maxdim)
+        s->density_levels++;
+    glCreateTextures(GL_TEXTURE_3D, 1, &s->density_tex);
+    glTextureStorage3D(s->density_tex, s->density_levels, GL_R32F, g.frame.dims[0], g.frame.dims[1], g.frame.dims[2]);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage3D(s->density_tex, 0, 0, 0, 0, g.frame.dims[0], g.frame.dims[1], g.frame.dims[2], GL_RED,
+                        GL_FLOAT, g.density);
+    glGenerateTextureMipmap(s->density_tex);
+    glTextureParameteri(s->density_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(s->density_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    const float zero[4] = {0, 0, 0, 0};
+    glTextureParameterfv(s->density_tex, GL_TEXTURE_BORDER_COLOR, zero);
+    glTextureParameteri(s->density_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(s->density_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(s->density_tex, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_BORDER);
+    /* AO at half resolution (at least 1): a low-frequency field. */
+    for (int c = 0; c < 3; c++)
+        s->ao_dims[c] = (g.frame.dims[c] + 1) / 2;
+    glCreateTextures(GL_TEXTURE_3D, 1, &s->ao_tex);
+    glTextureStorage3D(s->ao_tex, 1, GL_R8, s->ao_dims[0], s->ao_dims[1], s->ao_dims[2]);
+    glTextureParameteri(s->ao_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(s->ao_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(s->ao_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(s->ao_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(s->ao_tex, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    s->grid_bytes += (size_t)s->ao_dims[0] * s->ao_dims[1] * s->ao_dims[2];
+    s->ao_valid = 0;
+    st = upload_occupancy(s, g.counts, err);
+    if (st == SL_OK)
+        st = upload_representatives(s, &g, err);
+    s->ready = st == SL_OK;
+    if (st == SL_OK && g.dropped_overflow)
+        fprintf(stderr, "voxel_lines: %zu lines dropped in %zu voxels above the %d-line header limit "
+                        "(largest voxel: %d lines)\n", g.dropped_overflow, g.capped_voxels, s->max_per_voxel,
+                g.max_count);
+    s->grid_bytes += s->voxel_count * 8 / 7;
+    sl_voxel_grid_deinit(&g);
+    return st;
+}
+
+static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
+                                     sl_err *err)
+{
+    (void)gpu;
+    *out = NULL;
+    voxel_lines_state *s = calloc(1, sizeof *s);
+    if (!s)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    s->dataset = ds;
+    s->colormap_loaded = -1;
+    s->quant = atoi(sl_params_choice_name(params, "quantization"));
+    s->max_per_voxel = sl_params_int(params, "max_lines_per_voxel");
+    s->resolution = sl_params_int(params, "grid");
+    s->use_gpu = sl_params_choice(params, "voxelize") == 1;
+    sl_line_style style;
+    sl_line_style_read(params, ds, &style);
+    sl_status st = build_and_upload(s, style.attribute, err);
+    if (st == SL_OK)
+        st = sl_gl_program_create(&(sl_program_desc){.vertex = "voxel_lines/voxel_lines_fullscreen.vert.glsl",
+                                                     .fragment = "voxel_lines/voxel_lines.frag.glsl",
+                                                     .label = "voxel_lines"},
+                                  &s->program, err);
+    if (st == SL_OK)
+        st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxel_lines_ao.comp.glsl",
+                                                     .label = "voxel_lines_ao"},
+                                  &s->ao_program, err);
+    if (st != SL_OK) {
+        voxel_lines_release(s);
+        return st;
+    }
+    glCreateVertexArrays(1, &s->vao);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
+    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    *out = s;
+    return SL_OK;
+}
+
+static void set1f(GLuint p, const char *n, float v) { glUniform1f(glGetUniformLocation(p, n), v); }
+static void set1i(GLuint p, const char *n, int v) { glUniform1i(glGetUniformLocation(p, n), v); }
+
+static void compute_ao(voxel_lines_state *s, float extinction, int rays, float radius)
+{
+    glUseProgram(s->ao_program);
+    set1i(s->ao_program, "u_density", 0);
+    glBindTextureUnit(0, s->density_tex);
+    glUniform3i(glGetUniformLocation(s->ao_program, "u_ao_dims"), s->ao_dims[0], s->ao_dims[1], s->ao_dims[2]);
+    set1i(s->ao_program, "u_rays", rays);
+    set1f(s->ao_program, "u_radius", radius);
+    set1f(s->ao_program, "u_extinction", extinction);
+    glBindImageTexture(0, s->ao_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8);
+    glDispatchCompute((GLuint)(s->ao_dims[0] + 3) / 4, (GLuint)(s->ao_dims[1] + 3) / 4,
+                      (GLuint)(s->ao_dims[2] + 3) / 4);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
+                                    sl_render_stats *stats, sl_err *err)
+{
+    (void)target;
+    voxel_lines_state *s = opaque;
+    sl_line_style style;
+    sl_line_style_read(params, s->dataset, &style);
+    if (style.attribute != s->built_attribute || !s->ready) {
+        sl_status st = build_and_upload(s, style.attribute, err);
+        if (st != SL_OK)
+            return st;
+    }
+    if (style.colormap != s->colormap_loaded) {
+        uint8_t table[SL_COLORMAP_TEXELS * 4];
+        sl_colormap_table(style.colormap, table);
+        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
+        s->colormap_loaded = style.colormap;
+    }
+    const double h = s->frame.h;
+    float opacity = (float)sl_params_float(params, "opacity");
+    float radius_g = (float)(style.radius / h);
+    float extinction = opacity * 2.0f * radius_g;
+    int shadows = sl_params_bool(params, "shadows"), ao = sl_params_bool(params, "ao");
+    if (ao) {
+        int rays = sl_params_int(params, "ao_rays");
+        float ao_radius = (float)sl_params_float(params, "ao_radius");
+        float key[4] = {extinction, (float)rays, ao_radius, 1.0f};
+        if (!s->ao_valid || memcmp(key, s->ao_key, sizeof key) != 0) {
+            compute_ao(s, extinction, rays, ao_radius);
+            memcpy(s->ao_key, key, sizeof key);
+            s->ao_valid = 1;
+        }
+    }
+    int neighbors;
+    switch (sl_params_choice(params, "neighbors")) {
+    case 1: neighbors = 0; break;
+    case 2: neighbors = 1; break;
+    default: neighbors = view->quality == SL_QUALITY_STILL; break;
+    }
+    if (neighbors)
+        neighbors = radius_g > 1.0f ? (radius_g > 2.0f ? 2 : (int)ceilf(radius_g)) : 1;
+
+    sl_camera_ubo_update(&s->camera_ubo, view);
+    GLuint p = s->program;
+    glUseProgram(p);
+    const sl_dataset *ds = s->dataset;
+    sl_vec3 eye = sl_v3_sub(view->camera.eye, ds->origin);
+    glUniform3f(glGetUniformLocation(p, "u_eye_g"), (float)((eye.x - s->frame.lo[0]) / h),
+                (float)((eye.y - s->frame.lo[1]) / h), (float)((eye.z - s->frame.lo[2]) / h));
+    glUniform3i(glGetUniformLocation(p, "u_dims"), s->frame.dims[0], s->frame.dims[1], s->frame.dims[2]);
+    set1i(p, "u_quant", s->quant);
+    set1i(p, "u_quant_bits", s->quant_bits);
+    set1i(p, "u_line_bits", s->line_bits);
+    set1f(p, "u_inv_h", (float)(1.0 / h));
+    set1f(p, "u_radius_g", radius_g);
+    set1f(p, "u_opacity", opacity);
+    set1f(p, "u_alpha_stop", opacity >= 1.0f ? 1.0f : (float)sl_params_float(params, "alpha_threshold"));
+    set1i(p, "u_neighbors", neighbors);
+    set1i(p, "u_opacity_by_distance", sl_params_bool(params, "opacity_by_distance"));
+    set1i(p, "u_use_colormap", style.attribute >= 0);
+    set1i(p, "u_opacity_ramp", style.attribute >= 0 && sl_params_choice(params, "opacity_transfer") == 1);
+    float span = style.scalar_range[1] - style.scalar_range[0];
+    float attr_range[2] = {0.5f, 0.5f};
+    if (style.attribute >= 0 && span > 0.0f) {
+        const sl_attribute *a = &ds->lines.attributes[style.attribute];
+        attr_range[0] = (a->min - style.scalar_range[0]) / span;
+        attr_range[1] = (a->max - style.scalar_range[0]) / span;
+    }
+    glUniform2fv(glGetUniformLocation(p, "u_attr_range"), 1, attr_range);
+    glUniform3fv(glGetUniformLocation(p, "u_color"), 1, style.color);
+    glUniform3fv(glGetUniformLocation(p, "u_light_eye"), 1, style.light_direction);
+    glUniform4fv(glGetUniformLocation(p, "u_material"), 1, style.material);
+    set1i(p, "u_colormap", 0);
+    set1i(p, "u_density", 1);
+    set1i(p, "u_ao", 2);
+    set1i(p, "u_occupancy", 3);
+    set1i(p, "u_skip_levels", sl_params_bool(params, "empty_space_skipping") ? s->occupancy_levels - 1 : -1);
+    set1f(p, "u_extinction", extinction);
+    set1i(p, "u_shadows", shadows);
+    set1f(p, "u_shadow_strength", (float)sl_params_float(params, "shadow_strength"));
+    set1f(p, "u_shadow_lod", (float)sl_params_int(params, "shadow_lod"));
+    set1f(p, "u_max_lod", (float)(s->density_levels - 1));
+    set1i(p, "u_ao_on", ao);
+    int rep_level = sl_params_int(params, "shadow_lod");
+    rep_level = rep_level < 1 ? 1 : (rep_level >= s->rep_levels ? s->rep_levels - 1 : rep_level);
+    set1i(p, "u_shadow_lines", shadows && sl_params_choice(params, "shadow_mode") == 1 && rep_level >= 1);
+    glUniform3i(glGetUniformLocation(p, "u_rep_dims"), s->rep_dims[rep_level][0], s->rep_dims[rep_level][1],
+                s->rep_dims[rep_level][2]);
+    set1i(p, "u_rep_base", s->rep_base[rep_level]);
+    set1f(p, "u_rep_scale", (float)(1 << rep_level));
+    set1f(p, "u_ao_strength", (float)sl_params_float(params, "ao_strength"));
+    glBindTextureUnit(0, s->colormap_tex);
+    glBindTextureUnit(1, s->density_tex);
+    glBindTextureUnit(2, s->ao_tex);
+    glBindTextureUnit(3, s->occupancy_tex);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->offsets_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->counts_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s->lines_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->reps_buf);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(s->vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    stats->primitives = (double)view->width * view->height;
+    return SL_OK;
+}
+
+static size_t voxel_lines_gpu_bytes(const void *opaque)
+{
+    const voxel_lines_state *s = opaque;
+    return s ? s->grid_bytes : 0;
+}
+
+const sl_technique sl_voxel_lines_technique = {
+    .name = "voxel_lines",
+    .description = "voxel-based ray casting of line sets with transparency, soft shadows and AO (Kanzler et al. 2018)",
+    .dataset_kinds = SL_DATASET_LINES,
+    .params = voxel_lines_params,
+    .param_count = (int)(sizeof voxel_lines_params / sizeof voxel_lines_params[0]),
+    .prepare = voxel_lines_prepare,
+    .render = voxel_lines_render,
+    .release = voxel_lines_release,
+    .gpu_bytes = voxel_lines_gpu_bytes,
+};

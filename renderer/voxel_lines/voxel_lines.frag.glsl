@@ -1,0 +1,275 @@
+// voxel_lines.frag.glsl — one ray per pixel through the voxel model
+// (Kanzler et al., Sec. 4): 3D DDA front to back; in each visited voxel the
+// lines of the voxel (and, when u_neighbors = R > 0, of the voxels within R)
+// are intersected as capsules (cylinder + spheres at both ends, radius
+// u_radius_g in voxels) and kept sorted in a small pending list. Own voxel
+// only: a voxel's hits are composited when it is left. With neighbours each
+// voxel's lines are tested once (a neighbour already within R of the
+// previous voxel was tested then: the voxels a ray visits near a box are
+// consecutive), and a pending hit is composited once the ray leaves the voxel
+// holding its entry point — by then every capsule entering there was tested,
+// since its voxel is within R of that one (radius <= R voxels). Hits of one
+// curve (same local id) whose intervals overlap are one tube (the joint
+// spheres), blended once.
+// Opaque (u_opacity >= 1): the first hit ends the ray. Writes premultiplied
+// colour for blending (ONE, ONE_MINUS_SRC_ALPHA) and reversed-Z depth of the
+// first composited hit.
+#include "gpu/glsl/camera.glsl"
+#include "gpu/glsl/lighting.glsl"
+#include "gpu/glsl/colormap.glsl"
+#include "voxel_lines/voxel_lines_grid.glsl"
+uniform float u_radius_g;      // tube radius in voxels
+#include "voxel_lines/voxel_lines_light.glsl"
+
+uniform vec3 u_eye_g;          // eye in grid coordinates
+uniform float u_inv_h;         // 1 / voxel size (world)
+uniform float u_opacity;
+uniform float u_alpha_stop;    // alpha termination threshold
+uniform int u_neighbors;       // 0: own voxel only; R: (2R+1)^3 block
+uniform int u_opacity_by_distance;
+uniform int u_use_colormap;
+uniform int u_opacity_ramp;    // opacity x colormap coordinate
+uniform vec2 u_attr_range;     // colormap t of attribute bytes 0 and 255
+uniform sampler2D u_colormap;
+uniform vec3 u_color;
+uniform vec3 u_light_eye;
+uniform vec4 u_material;
+uniform usampler3D u_occupancy; // per level: 1 when a voxel within 2 of the block holds lines
+uniform int u_skip_levels;      // coarsest occupancy level used for empty-space skipping; < 0 = off
+
+layout(location = 0) out vec4 o_color;
+
+#define MAX_HITS 16
+float h_in[MAX_HITS], h_out[MAX_HITS];
+vec3 h_n[MAX_HITS];
+uint h_attr[MAX_HITS], h_id[MAX_HITS];
+int h_count;
+
+// Entry/exit of ray o + s d with the capsule a-b of radius r; false when missed.
+bool capsule(vec3 o, vec3 d, vec3 a, vec3 b, float r, out float t_in, out float t_out, out vec3 n)
+{
+    t_in = 1e30;
+    t_out = -1e30;
+    vec3 ba = b - a, oa = o - a;
+    float baba = dot(ba, ba), bard = dot(ba, d), baoa = dot(ba, oa);
+    float dd = dot(d, d), rdoa = dot(d, oa), oaoa = dot(oa, oa);
+    float qa = baba * dd - bard * bard;
+    if (qa > 1e-12 * baba * dd) {
+        float qb = baba * rdoa - baoa * bard;
+        float qc = baba * oaoa - baoa * baoa - r * r * baba;
+        float h = qb * qb - qa * qc;
+        if (h >= 0.0) {
+            h = sqrt(h);
+            float t0 = (-qb - h) / qa, t1 = (-qb + h) / qa;
+            float y0 = baoa + t0 * bard, y1 = baoa + t1 * bard;
+            if (y0 > 0.0 && y0 < baba) {
+                t_in = t0;
+                n = (oa + t0 * d - ba * (y0 / baba)) / r;
+            }
+            if (y1 > 0.0 && y1 < baba)
+                t_out = t1;
+        }
+    }
+    for (int e = 0; e < 2; e++) {
+        vec3 c = e == 0 ? a : b;
+        vec3 oc = o - c;
+        float sb = dot(oc, d), sc = dot(oc, oc) - r * r;
+        float h = sb * sb - dd * sc;
+        if (h < 0.0)
+            continue;
+        h = sqrt(h);
+        float t0 = (-sb - h) / dd, t1 = (-sb + h) / dd;
+        if (t0 < t_in) {
+            t_in = t0;
+            n = (oc + t0 * d) / r;
+        }
+        t_out = max(t_out, t1);
+    }
+    return t_in < 1e29;
+}
+
+void add_hit(float tin, float tout, vec3 n, uint attr, uint id)
+{
+    int i = h_count;
+    if (h_count == MAX_HITS) {
+        if (tin >= h_in[MAX_HITS - 1])
+            return; // keep the nearest MAX_HITS of a voxel
+        i = MAX_HITS - 1;
+    } else {
+        h_count++;
+    }
+    while (i > 0 && h_in[i - 1] > tin) {
+        h_in[i] = h_in[i - 1];
+        h_out[i] = h_out[i - 1];
+        h_n[i] = h_n[i - 1];
+        h_attr[i] = h_attr[i - 1];
+        h_id[i] = h_id[i - 1];
+        i--;
+    }
+    h_in[i] = tin;
+    h_out[i] = tout;
+    h_n[i] = n;
+    h_attr[i] = attr;
+    h_id[i] = id;
+}
+
+void main()
+{
+    vec3 d = sl_ray_direction(gl_FragCoord.xy) * u_inv_h; // grid units per unit of eye distance along F
+    vec3 o = u_eye_g;
+    float s_near = sl_near.x;
+    // Ray against the grid box.
+    vec3 inv = 1.0 / d;
+    vec3 t0 = (vec3(0.0) - o) * inv, t1 = (vec3(u_dims) - o) * inv;
+    vec3 tlo = min(t0, t1), thi = max(t0, t1);
+    float s_enter = max(max(max(tlo.x, tlo.y), tlo.z), s_near);
+    float s_exit = min(min(thi.x, thi.y), thi.z);
+    if (s_enter >= s_exit)
+        discard;
+    vec3 p = o + s_enter * d;
+    ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), u_dims - 1);
+    ivec3 step_dir = ivec3(sign(d));
+    vec3 next_plane = vec3(cell) + max(vec3(step_dir), vec3(0.0));
+    vec3 t_max = mix((next_plane - o) * inv, vec3(1e30), equal(step_dir, ivec3(0)));
+    vec3 t_delta = mix(abs(inv), vec3(1e30), equal(step_dir, ivec3(0)));
+
+    vec3 view_dir = -normalize(d);
+    vec3 light = normalize(u_light_eye.x * sl_right.xyz + u_light_eye.y * sl_up.xyz - u_light_eye.z * sl_forward.xyz);
+    sl_material mat = sl_material(u_material.x, u_material.y, u_material.z, u_material.w);
+
+    vec3 acc = vec3(0.0);
+    float alpha = 0.0;
+    float first_s = -1.0;
+    // The last composited tube interval per local id slot (joint merging).
+    float last_out[8];
+    uint last_id[8];
+    for (int i = 0; i < 8; i++) {
+        last_out[i] = -1e30;
+        last_id[i] = 0xffffffffu;
+    }
+    int last_next = 0;
+    int steps = u_dims.x + u_dims.y + u_dims.z + 3;
+    int R = u_neighbors;
+    ivec3 prev = ivec3(-1000000);
+    h_count = 0;
+    for (int it = 0; it < steps; it++) {
+        if (u_skip_levels >= 0 && texelFetch(u_occupancy, cell, 0).r == 0u) {
+            // Empty space: no line within 2 voxels, so no tube reaches here.
+            // Jump to the exit of the largest empty block holding the cell.
+            int L = 0;
+            for (int lv = u_skip_levels; lv >= 1; lv--)
+                if (texelFetch(u_occupancy, min(cell >> lv, textureSize(u_occupancy, lv) - 1), lv).r == 0u) {
+                    L = lv;
+                    break;
+                }
+            vec3 bmin = vec3((cell >> L) << L), bmax = bmin + float(1 << L);
+            vec3 tb = max((bmin - o) * inv, (bmax - o) * inv);
+            float s_skip = min(min(tb.x, tb.y), tb.z);
+            if (s_skip >= s_exit)
+                break;
+            int axis = tb.x <= tb.y && tb.x <= tb.z ? 0 : (tb.y <= tb.z ? 1 : 2);
+            vec3 q = o + s_skip * d;
+            ivec3 nc = clamp(ivec3(floor(q)), ivec3(bmin), ivec3(bmax) - 1); // on the block's face
+            nc[axis] = step_dir[axis] > 0 ? int(bmax[axis]) : int(bmin[axis]) - 1;
+            if (any(lessThan(nc, ivec3(0))) || any(greaterThanEqual(nc, u_dims)))
+                break;
+            cell = nc;
+            next_plane = vec3(cell) + max(vec3(step_dir), vec3(0.0));
+            t_max = mix((next_plane - o) * inv, vec3(1e30), equal(step_dir, ivec3(0)));
+            prev = ivec3(-1000000);
+            continue;
+        }
+        float s_leave = min(min(t_max.x, t_max.y), min(t_max.z, s_exit));
+        for (int dz = -R; dz <= R; dz++)
+            for (int dy = -R; dy <= R; dy++)
+                for (int dx = -R; dx <= R; dx++) {
+                    ivec3 c = cell + ivec3(dx, dy, dz);
+                    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, u_dims)))
+                        continue;
+                    if (all(lessThanEqual(abs(c - prev), ivec3(R))))
+                        continue; // already tested from the previous voxel
+                    int v = vx_index(c);
+                    uint count = vx_count(v);
+                    if (count == 0u)
+                        continue;
+                    uint first = vx_offsets[v];
+                    vec3 corner = vec3(c);
+                    for (uint l = 0u; l < count; l++) {
+                        vec3 a, b;
+                        uint attr, id;
+                        vx_line(first + l, a, b, attr, id);
+                        float tin, tout;
+                        vec3 n;
+                        if (!capsule(o, d, corner + a, corner + b, u_radius_g, tin, tout, n))
+                            continue;
+                        if (tout < s_near)
+                            continue;
+                        add_hit(max(tin, s_near), tout, n, attr, id);
+                    }
+                }
+        prev = R > 0 ? cell : ivec3(-1000000);
+        // Pending hits that start before this voxel's exit are final: every
+        // capsule entering there belongs to a voxel adjacent to one visited.
+        int used = 0;
+        for (int i = 0; i < h_count; i++) {
+            if (R > 0 && h_in[i] >= s_leave)
+                break;
+            used++;
+            bool merged = false;
+            for (int j = 0; j < 8; j++)
+                if (last_id[j] == h_id[i] && h_in[i] <= last_out[j] + 1e-4 * h_in[i]) {
+                    last_out[j] = max(last_out[j], h_out[i]);
+                    merged = true;
+                }
+            if (merged)
+                continue;
+            last_id[last_next] = h_id[i];
+            last_out[last_next] = h_out[i];
+            last_next = (last_next + 1) & 7;
+            float t = mix(u_attr_range.x, u_attr_range.y, float(h_attr[i]) / 255.0);
+            vec3 base = u_use_colormap != 0 ? sl_colormap(u_colormap, t, vec2(0.0, 1.0)) : u_color;
+            vec3 pos_g = o + h_in[i] * d;
+            vec3 n = normalize(h_n[i]);
+            vec3 c = clamp(sl_shade(base, n, light, view_dir, mat), 0.0, 1.0) * vx_light_factor(pos_g, n, light);
+            float a = u_opacity_ramp != 0 ? u_opacity * clamp(t, 0.0, 1.0) : u_opacity;
+            if (u_opacity_by_distance != 0 && a < 1.0) {
+                // Opacity per tube diameter of travelled distance.
+                float dist = (h_out[i] - h_in[i]) * length(d);
+                a = 1.0 - pow(1.0 - a, clamp(dist / (2.0 * u_radius_g), 0.0, 1.0));
+            }
+            if (first_s < 0.0)
+                first_s = h_in[i];
+            acc += (1.0 - alpha) * a * c;
+            alpha += (1.0 - alpha) * a;
+            if (alpha >= u_alpha_stop)
+                break;
+        }
+        for (int i = used; i < h_count; i++) {
+            h_in[i - used] = h_in[i];
+            h_out[i - used] = h_out[i];
+            h_n[i - used] = h_n[i];
+            h_attr[i - used] = h_attr[i];
+            h_id[i - used] = h_id[i];
+        }
+        h_count -= used;
+        if (alpha >= u_alpha_stop || s_leave >= s_exit)
+            break;
+        // Step to the next voxel.
+        if (t_max.x <= t_max.y && t_max.x <= t_max.z) {
+            cell.x += step_dir.x;
+            t_max.x += t_delta.x;
+        } else if (t_max.y <= t_max.z) {
+            cell.y += step_dir.y;
+            t_max.y += t_delta.y;
+        } else {
+            cell.z += step_dir.z;
+            t_max.z += t_delta.z;
+        }
+        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, u_dims)))
+            break;
+    }
+    if (first_s < 0.0)
+        discard;
+    gl_FragDepth = sl_near.x / first_s;
+    o_color = vec4(acc, alpha);
+}

@@ -1,0 +1,248 @@
+/* voxelize_gpu.c — the voxel model built with compute shaders (Kanzler et al., Sec. 3.3).
+ *
+ * Five passes of voxelize_gpu.comp.glsl: count pieces per curve, emit
+ * (voxel, code) items in curve order, voxel histogram, scatter item indices
+ * into per-voxel segments, and per voxel: sort by item index, apply the cap,
+ * bit-pack and sum lengths. The exclusive scans between passes (over curves;
+ * over voxels, uncapped and capped) run on the GPU (voxel_scan.comp.glsl);
+ * counts are read back only for statistics and the CPU copy of the headers.
+ * The result is read back into a
+ * CPU sl_voxel_grid equal to sl_voxel_grid_build's (test_voxel_gpu checks
+ * it) except: no attribute byte (always 0) and `degenerate` is not counted.
+ * Render thread only (needs the GL context).
+ */
+#include "voxel_gpu.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../gpu/sl_gpu.h"
+
+#define PASSES 5
+
+static GLuint ssbo(size_t bytes, const void *data)
+{
+    GLuint b;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, (GLsizeiptr)(bytes ? bytes : 4), data, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    if (!data) {
+        const GLuint zero = 0;
+        glClearNamedBufferData(b, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    }
+    return b;
+}
+
+/* Exclusive scan of n uints of `in` (each capped to cap when cap > 0) into a
+ * new buffer (returned; the caller deletes it). Blocks of 512 on the GPU,
+ * the block totals scanned recursively. */
+static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap)
+{
+    size_t blocks = (n + 511) / 512;
+    GLuint out = ssbo(n * sizeof(uint32_t), NULL), sums = ssbo(blocks * sizeof(uint32_t), NULL);
+    glUseProgram(prog[0]);
+    glUniform1ui(glGetUniformLocation(prog[0], "u_n"), (GLuint)n);
+    glUniform1ui(glGetUniformLocation(prog[0], "u_cap"), cap);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
+    glDispatchCompute((GLuint)blocks, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    if (blocks > 1) {
+        GLuint scanned = gpu_scan(prog, sums, blocks, 0);
+        glUseProgram(prog[1]);
+        glUniform1ui(glGetUniformLocation(prog[1], "u_n"), (GLuint)n);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, scanned);
+        glDispatchCompute((GLuint)blocks, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glDeleteBuffers(1, &scanned);
+    }
+    glDeleteBuffers(1, &sums);
+    return out;
+}
+
+static void run(GLuint program, GLuint count)
+{
+    glUseProgram(program);
+    glUniform1ui(glGetUniformLocation(program, "u_count"), count);
+    glDispatchCompute((count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const sl_voxel_grid_desc *desc,
+                                  sl_err *err)
+{
+    memset(g, 0, sizeof *g);
+    double t0 = sl_now_ms();
+    sl_voxel_grid_desc d = desc ? *desc : (sl_voxel_grid_desc){0};
+    if (d.quant == 0) d.quant = 32;
+    if (d.padding < 0) d.padding = 1;
+    if (d.max_per_voxel == 0) d.max_per_voxel = SL_VOXEL_COUNT_MAX;
+    int k = sl_voxel_quant_bits(d.quant);
+    if (k < 0)
+        return sl_err_set(err, SL_ERR_INVALID, "face quantization %d must be a power of two in 2..256", d.quant);
+    if (d.max_per_voxel < 1 || d.max_per_voxel > SL_VOXEL_COUNT_MAX)
+        return sl_err_set(err, SL_ERR_INVALID, "max lines per voxel %d must be in 1..%d", d.max_per_voxel,
+                          SL_VOXEL_COUNT_MAX);
+    sl_status st = sl_voxel_frame_init(&g->frame, ds, d.resolution, d.padding, err);
+    if (st != SL_OK)
+        return st;
+    const sl_lines *l = &ds->lines;
+    g->quant = d.quant;
+    g->quant_bits = k;
+    g->line_bytes = sl_voxel_line_bytes(k);
+    g->voxel_count = (size_t)g->frame.dims[0] * g->frame.dims[1] * g->frame.dims[2];
+    g->attribute_index = -1;
+
+    GLuint prog[PASSES] = {0}, scan_prog[2] = {0};
+    GLuint buf[10] = {0};
+    uint32_t *curve_counts = NULL, *voxel_counts = NULL, *line_starts = NULL;
+    for (int p = 0; p < PASSES && st == SL_OK; p++) {
+        char defines[64], label[32];
+        snprintf(defines, sizeof defines, "#define VX_PASS %d\n", p + 1);
+        snprintf(label, sizeof label, "voxelize_gpu_pass%d", p + 1);
+        st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxelize_gpu.comp.glsl",
+                                                     .defines = defines, .label = label},
+                                  &prog[p], err);
+    }
+    for (int p = 0; p < 2 && st == SL_OK; p++)
+        st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxel_scan.comp.glsl",
+                                                     .defines = p == 0 ? "#define SCAN_PASS 1\n"
+                                                                       : "#define SCAN_PASS 2\n",
+                                                     .label = "voxel_scan"},
+                                  &scan_prog[p], err);
+    if (st != SL_OK)
+        goto fail;
+    size_t curves = l->line_count;
+    buf[0] = ssbo(l->vertex_count * 3 * sizeof(float), l->positions);
+    buf[1] = ssbo((curves + 1) * sizeof(uint32_t), l->line_offsets);
+    buf[2] = ssbo((curves + 1) * sizeof(uint32_t), NULL);
+    for (int p = 0; p < PASSES; p++) {
+        GLuint pr = prog[p];
+        glUseProgram(pr);
+        glUniform3d(glGetUniformLocation(pr, "u_lo"), g->frame.lo[0], g->frame.lo[1], g->frame.lo[2]);
+        glUniform1d(glGetUniformLocation(pr, "u_h"), g->frame.h);
+        glUniform3i(glGetUniformLocation(pr, "u_dims"), g->frame.dims[0], g->frame.dims[1], g->frame.dims[2]);
+        glUniform1i(glGetUniformLocation(pr, "u_quant"), d.quant);
+        glUniform1i(glGetUniformLocation(pr, "u_k"), k);
+        glUniform1ui(glGetUniformLocation(pr, "u_cap"), (GLuint)d.max_per_voxel);
+        glUniform1i(glGetUniformLocation(pr, "u_line_bits"), 8 * g->line_bytes);
+    }
+    for (int b = 0; b < 3; b++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)b, buf[b]);
+
+    /* 1: pieces per curve; their exclusive scan (GPU) gives each curve's
+     * first item. The counts are read back only for statistics. */
+    run(prog[0], (GLuint)curves);
+    curve_counts = malloc((curves + 1) * sizeof *curve_counts);
+    if (!curve_counts) {
+        st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization: out of memory");
+        goto fail;
+    }
+    glGetNamedBufferSubData(buf[2], 0, (GLsizeiptr)((curves + 1) * sizeof(uint32_t)), curve_counts);
+    size_t total = 0;
+    for (size_t c = 0; c < curves; c++) {
+        total += curve_counts[c];
+        g->curves_without_pieces += curve_counts[c] == 0;
+    }
+    if (total > (size_t)SL_MAX_VERTICES * 8u) {
+        st = sl_err_set(err, SL_ERR_LIMIT, "GPU voxelization: more than %u pieces", SL_MAX_VERTICES * 8u);
+        goto fail;
+    }
+    GLuint curve_starts = gpu_scan(scan_prog, buf[2], curves + 1, 0);
+    glDeleteBuffers(1, &buf[2]);
+    buf[2] = curve_starts;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buf[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buf[1]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, buf[2]);
+    g->pieces = total;
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    size_t biggest = total * 16u > (g->voxel_count + 1) * 4u ? total * 16u : (g->voxel_count + 1) * 4u;
+    if (max_block > 0 && biggest > (size_t)max_block) {
+        st = sl_err_set(err, SL_ERR_LIMIT,
+                        "GPU voxelization: a %zu-byte buffer (%zu pieces, %zu voxels) exceeds the shader storage "
+                        "block limit of %lld bytes; use the CPU build or a smaller grid",
+                        biggest, total, g->voxel_count, (long long)max_block);
+        goto fail;
+    }
+
+    /* 2: items in curve order; 3: voxel histogram. */
+    buf[3] = ssbo(total * 4 * sizeof(uint32_t), NULL);
+    buf[4] = ssbo((g->voxel_count + 1) * sizeof(uint32_t), NULL);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, buf[3]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, buf[4]);
+    run(prog[1], (GLuint)curves);
+    run(prog[2], (GLuint)total);
+    voxel_counts = malloc(g->voxel_count * sizeof *voxel_counts);
+    line_starts = malloc((g->voxel_count + 1) * sizeof *line_starts);
+    g->offsets = malloc(g->voxel_count * sizeof *g->offsets);
+    g->counts = malloc(g->voxel_count);
+    g->density = malloc(g->voxel_count * sizeof *g->density);
+    if (!voxel_counts || !line_starts || !g->offsets || !g->counts || !g->density) {
+        st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization of %zu voxels: out of memory", g->voxel_count);
+        goto fail;
+    }
+    /* Headers: exclusive scans of the histogram, uncapped (segments) and
+     * capped (line offsets), on the GPU. The counts are read back for the
+     * CPU copy of the headers and the statistics. */
+    glGetNamedBufferSubData(buf[4], 0, (GLsizeiptr)(g->voxel_count * sizeof(uint32_t)), voxel_counts);
+    buf[5] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, 0);
+    buf[7] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, (GLuint)d.max_per_voxel);
+    glGetNamedBufferSubData(buf[7], 0, (GLsizeiptr)((g->voxel_count + 1) * sizeof(uint32_t)), line_starts);
+    size_t s_kept = line_starts[g->voxel_count];
+    for (size_t v = 0; v < g->voxel_count; v++) {
+        uint32_t n = voxel_counts[v];
+        g->offsets[v] = line_starts[v];
+        if ((int)n > g->max_count)
+            g->max_count = (int)n;
+        uint32_t kept = n > (uint32_t)d.max_per_voxel ? (uint32_t)d.max_per_voxel : n;
+        if (kept < n) {
+            g->dropped_overflow += n - kept;
+            g->capped_voxels++;
+        }
+        g->counts[v] = (uint8_t)kept;
+    }
+    g->line_count = s_kept;
+
+    /* 4: scatter into segments; 5: sort, cap, pack, density. */
+    const GLuint zero = 0;
+    glClearNamedBufferData(buf[4], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    buf[6] = ssbo(total * sizeof(uint32_t), NULL);
+    size_t word_count = (s_kept * (size_t)g->line_bytes + 8 + 3) / 4 + 3;
+    buf[8] = ssbo(word_count * sizeof(uint32_t), NULL);
+    buf[9] = ssbo(g->voxel_count * sizeof(float), NULL);
+    for (int b = 5; b < 10; b++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)b, buf[b]);
+    run(prog[3], (GLuint)total);
+    run(prog[4], (GLuint)g->voxel_count);
+    g->lines = calloc(word_count, sizeof(uint32_t));
+    if (!g->lines) {
+        st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization: %zu lines do not fit in memory", s_kept);
+        goto fail;
+    }
+    glGetNamedBufferSubData(buf[8], 0, (GLsizeiptr)(word_count * sizeof(uint32_t)), g->lines);
+    glGetNamedBufferSubData(buf[9], 0, (GLsizeiptr)(g->voxel_count * sizeof(float)), g->density);
+    /* The CPU layout keeps 8 zero bytes after the last line. */
+    memset(g->lines + s_kept * (size_t)g->line_bytes, 0, word_count * 4 - s_kept * (size_t)g->line_bytes);
+    g->build_ms = sl_now_ms() - t0;
+    st = SL_OK;
+    goto done;
+fail:
+    sl_voxel_grid_deinit(g);
+done:
+    for (int p = 0; p < PASSES; p++)
+        if (prog[p])
+            glDeleteProgram(prog[p]);
+    for (int p = 0; p < 2; p++)
+        if (scan_prog[p])
+            glDeleteProgram(scan_prog[p]);
+    for (int b = 0; b < 10; b++)
+        if (buf[b])
+            glDeleteBuffers(1, &buf[b]);
+    free(curve_counts);
+    free(voxel_counts);
+    free(line_starts);
+    return st;
+}

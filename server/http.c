@@ -1,0 +1,113 @@
+/* http.c — the bodies of GET /healthz (JSON) and GET /metrics (Prometheus text 0.0.4).
+ *
+ * Metrics are counters and gauges read under srv->lock in one pass, so a
+ * scrape sees one consistent snapshot; the two histograms (render ms and
+ * encode ms per frame) use fixed millisecond buckets. Does not send
+ * anything (ws.c does). Service thread; sl_histogram_add is called by the
+ * render thread with the lock held.
+ */
+#include "sl_server.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double bucket_ms[SL_HIST_BUCKETS - 1] = {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 5000};
+
+void sl_histogram_add(sl_histogram *h, double ms)
+{
+    for (int i = 0; i < SL_HIST_BUCKETS - 1; i++)
+        if (ms <= bucket_ms[i])
+            h->counts[i]++;
+    h->counts[SL_HIST_BUCKETS - 1]++;
+    h->sum += ms;
+    h->total++;
+}
+
+char *sl_http_healthz(sl_server *srv, int *status)
+{
+    pthread_mutex_lock(&srv->lock);
+    int ok = srv->render_ready > 0 && !srv->stop;
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "status", ok ? "ok" : "unavailable");
+    cJSON_AddNumberToObject(o, "uptime_s", (sl_server_now_ms() - srv->start_ms) / 1000.0);
+    cJSON_AddNumberToObject(o, "sessions", srv->session_count);
+    cJSON_AddNumberToObject(o, "clients", srv->client_count);
+    cJSON_AddStringToObject(o, "renderer", srv->gpu_renderer);
+    cJSON_AddNumberToObject(o, "protocol", SL_PROTO_VERSION);
+    pthread_mutex_unlock(&srv->lock);
+    *status = ok ? 200 : 503;
+    char *text = cJSON_PrintUnformatted(o);
+    cJSON_Delete(o);
+    return text;
+}
+
+/* Appends to a growing buffer; on allocation failure the buffer is freed and set NULL. */
+static void append(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void append(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+{
+    if (!*buf)
+        return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(*buf + *len, *cap - *len, fmt, ap);
+        va_end(ap);
+        if (n < 0)
+            return;
+        if ((size_t)n < *cap - *len) {
+            *len += (size_t)n;
+            return;
+        }
+        char *p = realloc(*buf, *cap * 2 + (size_t)n);
+        if (!p) {
+            free(*buf);
+            *buf = NULL;
+            return;
+        }
+        *buf = p;
+        *cap = *cap * 2 + (size_t)n;
+    }
+}
+
+static void histogram(char **b, size_t *len, size_t *cap, const char *name, const char *help, const sl_histogram *h)
+{
+    append(b, len, cap, "# HELP %s %s\n# TYPE %s histogram\n", name, help, name);
+    for (int i = 0; i < SL_HIST_BUCKETS - 1; i++)
+        append(b, len, cap, "%s_bucket{le=\"%g\"} %llu\n", name, bucket_ms[i], (unsigned long long)h->counts[i]);
+    append(b, len, cap, "%s_bucket{le=\"+Inf\"} %llu\n", name, (unsigned long long)h->counts[SL_HIST_BUCKETS - 1]);
+    append(b, len, cap, "%s_sum %.3f\n%s_count %llu\n", name, h->sum, name, (unsigned long long)h->total);
+}
+
+char *sl_http_metrics(sl_server *srv)
+{
+    size_t len = 0, cap = 4096;
+    char *b = malloc(cap);
+    pthread_mutex_lock(&srv->lock);
+    sl_metrics m = srv->metrics;
+    int sessions = srv->session_count, clients = srv->client_count;
+    pthread_mutex_unlock(&srv->lock);
+    struct { const char *name, *help; uint64_t v; } counters[] = {
+        {"sightline_frames_rendered_total", "Frames rendered and encoded.", m.frames_rendered},
+        {"sightline_frames_sent_total", "Frame messages sent to clients.", m.frames_sent},
+        {"sightline_frames_dropped_total", "Frames a client never received because a newer one replaced them.",
+         m.frames_dropped},
+        {"sightline_frames_failed_total", "Renders that failed (error sent to the session).", m.frames_failed},
+        {"sightline_snapshots_total", "PNG snapshots rendered.", m.snapshots},
+        {"sightline_frame_bytes_sent_total", "Bytes of frame messages sent.", m.bytes_sent},
+        {"sightline_messages_received_total", "Client text messages received.", m.messages_in},
+        {"sightline_errors_sent_total", "error messages sent to clients.", m.errors_sent},
+    };
+    for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
+        append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,
+               counters[i].name, counters[i].name, (unsigned long long)counters[i].v);
+    append(&b, &len, &cap, "# HELP sightline_clients Connected WebSocket clients.\n# TYPE sightline_clients gauge\n"
+           "sightline_clients %d\n", clients);
+    append(&b, &len, &cap, "# HELP sightline_sessions Live sessions.\n# TYPE sightline_sessions gauge\n"
+           "sightline_sessions %d\n", sessions);
+    histogram(&b, &len, &cap, "sightline_render_ms", "Render plus readback wall time per frame, ms.", &m.render_ms);
+    histogram(&b, &len, &cap, "sightline_encode_ms", "JPEG encode wall time per frame, ms.", &m.encode_ms);
+    return b;
+}

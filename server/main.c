@@ -1,0 +1,280 @@
+/* main.c — sightline-server: arguments, the `catalog` subcommand, start and orderly stop.
+ *
+ *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH] [--data-dir DIR]...
+ *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
+ *                    [--max-sessions N] [--grace S] [--egl-device D]
+ *                    [--default-dataset NAME]
+ *   sightline-server catalog add PATH | add-generator NAME JSON | list | remove NAME | scan DIR
+ *                    [--db PATH] [--data-dir DIR]
+ *
+ * The work is elsewhere (see sl_server.h for the map): this file opens the
+ * catalog, starts the render thread (render.c), creates the lws context
+ * (ws.c) and runs the service loop on the main thread until SIGINT/SIGTERM.
+ * Stop order matters: render thread first (it calls lws_cancel_service),
+ * then the lws context (closing clients), then sessions, then the catalog.
+ * --port 0 picks a free port; the chosen one is printed as
+ * "listening on http://ADDR:PORT/" on stdout (tests read it).
+ */
+#include "sl_server.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "core/sl_technique.h"
+#include "sl_params_json.h"
+
+#ifndef SL_SOURCE_DIR
+#define SL_SOURCE_DIR "."
+#endif
+
+static volatile int interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+double sl_server_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
+            "                        [--allow-origin URL]... [--max-clients N] [--max-sessions N] [--grace SECONDS]\n"
+            "                        [--egl-device software|INDEX] [--default-dataset NAME]\n"
+            "       sightline-server catalog add PATH | add-generator NAME JSON | list | remove NAME | scan DIR\n"
+            "                        [--db PATH] [--data-dir DIR]\n");
+}
+
+static int dir_exists(const char *p)
+{
+    struct stat sb;
+    return stat(p, &sb) == 0 && S_ISDIR(sb.st_mode);
+}
+
+/* mkdir -p for the directory part of path. */
+static void make_parent_dirs(const char *path)
+{
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", path);
+    for (char *p = tmp + 1; *p; p++) {
+        if (*p == '/') {
+            *p = '\0';
+            mkdir(tmp, 0755);
+            *p = '/';
+        }
+    }
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || !end || *end || v < lo || v > hi)
+        return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static int run_catalog(sl_server_config *cfg, int argc, char **argv)
+{
+    if (argc < 1) {
+        usage(stderr);
+        return 2;
+    }
+    sqlite3 *db = NULL;
+    sl_err err = {0};
+    if (sl_catalog_open(cfg->db_path, &db, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+        return 1;
+    }
+    int rc = 0;
+    const char *cmd = argv[0];
+    if (strcmp(cmd, "list") == 0 && argc == 1) {
+        if (sl_catalog_init_defaults(db, cfg->data_dirs, cfg->data_dir_count, &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        }
+        cJSON *list = sl_catalog_list_json(db);
+        const cJSON *d;
+        cJSON_ArrayForEach(d, list) {
+            const cJSON *name = cJSON_GetObjectItemCaseSensitive(d, "name");
+            const cJSON *kind = cJSON_GetObjectItemCaseSensitive(d, "kind");
+            char *counts = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(d, "counts"));
+            const cJSON *path = cJSON_GetObjectItemCaseSensitive(d, "path");
+            printf("%-20s %-8s %-40s %s\n", name->valuestring, kind->valuestring, counts ? counts : "",
+                   cJSON_IsString(path) ? path->valuestring : "(generator)");
+            free(counts);
+        }
+        cJSON_Delete(list);
+    } else if (strcmp(cmd, "add") == 0 && argc == 2) {
+        if (sl_catalog_add_file(db, argv[1], cfg->data_dirs, cfg->data_dir_count, &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        }
+    } else if (strcmp(cmd, "add-generator") == 0 && argc == 3) {
+        if (sl_catalog_add_generator(db, argv[1], argv[2], &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        }
+    } else if (strcmp(cmd, "remove") == 0 && argc == 2) {
+        if (sl_catalog_remove(db, argv[1], &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        }
+    } else if (strcmp(cmd, "scan") == 0 && argc == 2) {
+        int added = 0;
+        if (sl_catalog_scan(db, argv[1], cfg->data_dirs, cfg->data_dir_count, &added, &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        } else {
+            printf("added %d dataset(s)\n", added);
+        }
+    } else {
+        usage(stderr);
+        rc = 2;
+    }
+    sl_catalog_close(db);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    sl_server_config cfg = {.port = 8080, .bind = "127.0.0.1", .max_clients = 64, .max_sessions = 32,
+                            .grace_s = 300};
+    char db_default[PATH_MAX], web_default[PATH_MAX], data_default[PATH_MAX];
+    const char *xdg = getenv("XDG_DATA_HOME"), *home = getenv("HOME");
+    if (xdg && xdg[0])
+        snprintf(db_default, sizeof db_default, "%s/sightline/catalog.db", xdg);
+    else
+        snprintf(db_default, sizeof db_default, "%s/.local/share/sightline/catalog.db", home ? home : ".");
+    cfg.db_path = db_default;
+    snprintf(web_default, sizeof web_default, "%s", dir_exists("web") ? "web" : SL_SOURCE_DIR "/web");
+    cfg.web_dir = web_default;
+    int catalog_at = 0;
+    char *positional[4];
+    int npos = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int ok = 1;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--port") == 0 && v) {
+            ok = parse_int(v, 0, 65535, &cfg.port), i++;
+        } else if (strcmp(a, "--bind") == 0 && v) {
+            cfg.bind = v, i++;
+        } else if (strcmp(a, "--db") == 0 && v) {
+            cfg.db_path = v, i++;
+        } else if (strcmp(a, "--web-dir") == 0 && v) {
+            cfg.web_dir = v, i++;
+        } else if (strcmp(a, "--data-dir") == 0 && v) {
+            ok = cfg.data_dir_count < SL_SERVER_MAX_DATA_DIRS;
+            if (ok)
+                cfg.data_dirs[cfg.data_dir_count++] = v;
+            i++;
+        } else if (strcmp(a, "--allow-origin") == 0 && v) {
+            ok = cfg.origin_count < SL_SERVER_MAX_ORIGINS;
+            if (ok)
+                cfg.origins[cfg.origin_count++] = v;
+            i++;
+        } else if (strcmp(a, "--max-clients") == 0 && v) {
+            ok = parse_int(v, 1, 10000, &cfg.max_clients), i++;
+        } else if (strcmp(a, "--max-sessions") == 0 && v) {
+            ok = parse_int(v, 1, 10000, &cfg.max_sessions), i++;
+        } else if (strcmp(a, "--grace") == 0 && v) {
+            ok = parse_int(v, 0, 86400, &cfg.grace_s), i++;
+        } else if (strcmp(a, "--default-dataset") == 0 && v) {
+            cfg.default_dataset = v, i++;
+        } else if (strcmp(a, "--egl-device") == 0 && v) {
+            cfg.egl_device = v, i++;
+        } else if (a[0] != '-' && (catalog_at || (i == 1 && strcmp(a, "catalog") == 0))) {
+            if (!catalog_at)
+                catalog_at = i;
+            else if (npos < 4)
+                positional[npos++] = argv[i];
+            else
+                ok = 0;
+        } else {
+            ok = 0;
+        }
+        if (!ok) {
+            fprintf(stderr, "sightline-server: bad or incomplete argument \"%s\"\n", a);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (cfg.data_dir_count == 0) {
+        snprintf(data_default, sizeof data_default, "%s", dir_exists("data") ? "data" : SL_SOURCE_DIR "/data");
+        cfg.data_dirs[cfg.data_dir_count++] = data_default;
+    }
+    if (cfg.db_path == db_default)
+        make_parent_dirs(db_default);
+    if (catalog_at)
+        return run_catalog(&cfg, npos, positional);
+
+    sl_server *srv = calloc(1, sizeof *srv);
+    if (!srv)
+        return 1;
+    srv->cfg = cfg;
+    srv->start_ms = sl_server_now_ms();
+    pthread_mutex_init(&srv->lock, NULL);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&srv->wake, &ca);
+    pthread_condattr_destroy(&ca);
+    sl_err err = {0};
+    int rc = 1, port = 0;
+    if (sl_catalog_open(cfg.db_path, &srv->db, &err) != SL_OK ||
+        sl_catalog_init_defaults(srv->db, cfg.data_dirs, cfg.data_dir_count, &err) != SL_OK ||
+        sl_catalog_sessions_clear(srv->db, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+        goto done;
+    }
+    srv->techniques_json = cJSON_CreateArray();
+    int tc = 0;
+    const sl_technique *const *techs = sl_technique_list(&tc);
+    for (int i = 0; i < tc; i++)
+        cJSON_AddItemToArray(srv->techniques_json, sl_technique_json(techs[i]));
+    if (sl_render_start(srv, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+        goto done;
+    }
+    if (sl_ws_create(srv, &port, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+        goto done;
+    }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    signal(SIGPIPE, SIG_IGN);
+    printf("sightline-server: renderer %s\n", srv->gpu_renderer);
+    printf("sightline-server: listening on http://%s:%d/\n", cfg.bind, port);
+    fflush(stdout);
+    sl_ws_run(srv, &interrupted);
+    rc = 0;
+done:
+    sl_render_stop(srv);
+    sl_ws_destroy(srv);
+    sl_sessions_destroy_all(srv);
+    sl_catalog_close(srv->db);
+    cJSON_Delete(srv->techniques_json);
+    pthread_cond_destroy(&srv->wake);
+    pthread_mutex_destroy(&srv->lock);
+    free(srv);
+    return rc;
+}

@@ -1,0 +1,362 @@
+/* render.c — the render thread: the only thread that touches EGL/GL.
+ *
+ * It owns the sl_gpu, the encoder and one sl_pipeline per session (so each
+ * session keeps its prepared technique state and a camera move costs one
+ * render; sessions are capped by --max-sessions, so pipelines are too).
+ * Loop: under srv->lock pick the next session that needs work (a snapshot,
+ * a state version not yet rendered, or a due still frame), copy its desired
+ * state, unlock, render + read back + encode, lock, publish the frame as the
+ * session's one latest frame (dropping the older one), unlock and wake the
+ * service thread with lws_cancel_service. State that changed meanwhile is
+ * simply rendered next time: the newest state wins, nothing is queued.
+ * Interactive frames (camera phase start/move/end younger than
+ * still_delay_ms) render at interactive_scale and JPEG quality; once the
+ * delay passes a full-size still frame follows. Sessions are picked round
+ * robin so one busy session cannot starve another. Never touches a socket.
+ */
+#include "sl_server.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <libwebsockets.h>
+
+#include "core/sl_technique.h"
+#include "data/sl_generate.h"
+#include "data/sl_load.h"
+#include "gpu/sl_gpu.h"
+#include "pipeline/sl_pipeline.h"
+#include "sl_scene.h"
+
+enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT };
+
+typedef struct render_ctx {
+    sl_server *srv;
+    sl_gpu *gpu;
+    sl_encoder *enc;
+    uint8_t *rgba;
+    size_t rgba_cap;
+    unsigned rr;          /* round-robin start */
+} render_ctx;
+
+/* Picks work under the lock; fills *deadline_ms with the next still due time (or leaves it). */
+static sl_session *pick_job(sl_server *srv, unsigned *rr, enum job_kind *kind, double now, double *deadline_ms)
+{
+    int n = 0;
+    for (sl_session *s = srv->sessions; s; s = s->next)
+        n++;
+    if (n == 0)
+        return NULL;
+    for (int k = 0; k < n; k++) {
+        int idx = (int)((*rr + (unsigned)k) % (unsigned)n);
+        sl_session *s = srv->sessions;
+        for (int i = 0; i < idx; i++)
+            s = s->next;
+        if (s->doomed)
+            continue;
+        double still_due = s->state.camera_ms + s->state.stream.still_delay_ms;
+        if (s->snap_req_count > 0 && !s->snap_ready) {
+            *kind = JOB_SNAPSHOT;
+        } else if (s->state.version != s->rendered_version) {
+            *kind = JOB_FRAME;
+        } else if (s->rendered_interactive && now >= still_due) {
+            *kind = JOB_STILL;
+        } else {
+            if (s->rendered_interactive && still_due < *deadline_ms)
+                *deadline_ms = still_due;
+            continue;
+        }
+        *rr = (unsigned)idx + 1;
+        return s;
+    }
+    return NULL;
+}
+
+static sl_status ensure_rgba(render_ctx *ctx, int w, int h, sl_err *err)
+{
+    size_t need = (size_t)w * (size_t)h * 4;
+    if (need <= ctx->rgba_cap)
+        return SL_OK;
+    uint8_t *p = realloc(ctx->rgba, need);
+    if (!p)
+        return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate a %dx%d readback buffer", w, h);
+    ctx->rgba = p;
+    ctx->rgba_cap = need;
+    return SL_OK;
+}
+
+/* Loads the dataset when its source changed, selects the technique and renders. */
+static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
+                              int *w_out, int *h_out, double *render_ms, sl_err *err)
+{
+    sl_status rc;
+    if (!s->pipeline && (rc = sl_pipeline_create(ctx->gpu, &s->pipeline, err)) != SL_OK)
+        return rc;
+    if (strcmp(s->loaded_source, st->dataset_source) != 0 || !sl_pipeline_dataset(s->pipeline)) {
+        sl_dataset *ds = NULL;
+        rc = st->dataset_is_file ? sl_load_file(st->dataset_source, &ds, err)
+                                 : sl_generate_json(st->dataset_source, &ds, err);
+        if (rc) {
+            sl_err_prefix(err, "dataset \"%s\"", st->dataset);
+            return rc;
+        }
+        char *b = NULL, *c = NULL, *a = NULL;
+        sl_catalog_describe(ds, &b, &c, &a);
+        sl_pipeline_set_dataset(s->pipeline, ds);
+        snprintf(s->loaded_source, sizeof s->loaded_source, "%s", st->dataset_source);
+        pthread_mutex_lock(&ctx->srv->lock);
+        free(s->info_bounds);
+        free(s->info_counts);
+        free(s->info_attrs);
+        s->info_bounds = b;
+        s->info_counts = c;
+        s->info_attrs = a;
+        snprintf(s->info_dataset, sizeof s->info_dataset, "%s", st->dataset);
+        s->info_pending = 1;
+        pthread_mutex_unlock(&ctx->srv->lock);
+    }
+    const sl_dataset *ds = sl_pipeline_dataset(s->pipeline);
+    const sl_technique *t = sl_technique_find(st->technique);
+    if (!t)
+        return sl_err_set(err, SL_ERR_INVALID, "technique \"%s\" is not in this build", st->technique);
+    if ((rc = sl_pipeline_set_technique(s->pipeline, t, &st->params, err)) != SL_OK)
+        return rc;
+    cJSON *cam = cJSON_Parse(st->camera_json);
+    sl_view view;
+    memset(&view, 0, sizeof view);
+    int is_orbit = 0;
+    sl_orbit orbit;
+    rc = sl_camera_json_parse(cam, &is_orbit, &view.camera, &orbit, err);
+    cJSON_Delete(cam);
+    if (rc)
+        return rc;
+    if (is_orbit && (rc = sl_camera_from_orbit(&orbit, ds->bounds_min, ds->bounds_max, &view.camera, err)))
+        return rc;
+    int w = st->width, h = st->height;
+    if (interactive) {
+        w = (int)lround(w * st->stream.interactive_scale);
+        h = (int)lround(h * st->stream.interactive_scale);
+        w = w < 1 ? 1 : w;
+        h = h < 1 ? 1 : h;
+    }
+    view.width = w;
+    view.height = h;
+    view.quality = interactive ? SL_QUALITY_INTERACTIVE : SL_QUALITY_STILL;
+    memcpy(view.background, st->background, sizeof view.background);
+    view.origin = ds->origin;
+    if ((rc = sl_view_init(&view, sl_dataset_radius(ds), err)) != SL_OK)
+        return rc;
+    double t0 = sl_now_ms();
+    sl_frame_stats stats;
+    if ((rc = sl_pipeline_render(s->pipeline, &view, 1, &stats, err)) != SL_OK)
+        return rc;
+    if ((rc = ensure_rgba(ctx, w, h, err)) != SL_OK)
+        return rc;
+    *w_out = w;
+    *h_out = h;
+    *render_ms = sl_now_ms() - t0; /* completed by the caller's readback */
+    return SL_OK;
+}
+
+static void report_error(sl_server *srv, sl_session *s, const sl_session_state *st, const sl_err *err)
+{
+    pthread_mutex_lock(&srv->lock);
+    snprintf(s->error_text, sizeof s->error_text, "%.500s", err->message);
+    s->error_seq++;
+    s->rendered_version = st->version;
+    s->rendered_interactive = 0;
+    srv->metrics.frames_failed++;
+    pthread_mutex_unlock(&srv->lock);
+}
+
+static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive)
+{
+    sl_err err = {0};
+    int w = 0, h = 0;
+    double render_ms = 0, encode_ms = 0;
+    double t0 = sl_now_ms();
+    sl_frame_buf *f = NULL;
+    if (render_state(ctx, s, st, interactive, &w, &h, &render_ms, &err) != SL_OK) {
+        report_error(ctx->srv, s, st, &err);
+        return;
+    }
+    sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 0);
+    render_ms = sl_now_ms() - t0;
+    int quality = interactive ? st->stream.interactive_quality : st->stream.still_quality;
+    int sub420 = interactive ? st->stream.interactive_420 : st->stream.still_420;
+    if (sl_encoder_jpeg(ctx->enc, ctx->rgba, w, h, quality, sub420, &f, &encode_ms, &err) != SL_OK) {
+        report_error(ctx->srv, s, st, &err);
+        return;
+    }
+    sl_server *srv = ctx->srv;
+    pthread_mutex_lock(&srv->lock);
+    f->header.frame_id = ++s->next_frame_id;
+    f->header.state_version = st->version;
+    f->header.flags = interactive ? SL_FRAME_FLAG_INTERACTIVE : 0;
+    f->header.render_ms = (float)render_ms;
+    f->header.camera_seq = st->camera_seq;
+    sl_frame_header_write(&f->header, f->data);
+    sl_frame_buf_unref(s->latest);
+    s->latest = f;
+    s->rendered_version = st->version;
+    s->rendered_interactive = interactive;
+    srv->metrics.frames_rendered++;
+    sl_histogram_add(&srv->metrics.render_ms, render_ms);
+    sl_histogram_add(&srv->metrics.encode_ms, encode_ms);
+    pthread_mutex_unlock(&srv->lock);
+}
+
+static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *st, const int *ids, int n)
+{
+    sl_err err = {0};
+    int w = 0, h = 0;
+    double render_ms = 0, encode_ms = 0;
+    sl_frame_buf *f = NULL;
+    sl_server *srv = ctx->srv;
+    if (render_state(ctx, s, st, 0, &w, &h, &render_ms, &err) == SL_OK) {
+        sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 1);
+        if (sl_encoder_png(ctx->rgba, w, h, &f, &encode_ms, &err) == SL_OK) {
+            f->header.state_version = st->version;
+            f->header.render_ms = (float)render_ms;
+            f->header.camera_seq = st->camera_seq;
+            sl_frame_header_write(&f->header, f->data);
+        }
+    }
+    pthread_mutex_lock(&srv->lock);
+    if (f) {
+        s->snap_ready = f;
+        memcpy(s->snap_ready_ids, ids, sizeof(int) * (size_t)n);
+        s->snap_ready_count = n;
+        srv->metrics.snapshots++;
+    } else {
+        snprintf(s->error_text, sizeof s->error_text, "snapshot failed: %.480s", err.message);
+        s->error_seq++;
+    }
+    pthread_mutex_unlock(&srv->lock);
+}
+
+/* Unlinks doomed sessions (lock held) and frees them with their pipelines. */
+static void reap(sl_server *srv)
+{
+    sl_session **pp = &srv->sessions;
+    while (*pp) {
+        sl_session *s = *pp;
+        if (s->doomed && !s->rendering) {
+            *pp = s->next;
+            sl_pipeline_destroy(s->pipeline);
+            s->pipeline = NULL;
+            sl_session_free(s);
+        } else {
+            pp = &s->next;
+        }
+    }
+}
+
+static void *render_main(void *arg)
+{
+    render_ctx ctx = {.srv = arg};
+    sl_server *srv = ctx.srv;
+    sl_err err = {0};
+    sl_gpu_desc desc = {.device = srv->cfg.egl_device, .quiet = 1};
+    sl_status st = sl_gpu_create(&desc, &ctx.gpu, &err);
+    if (st == SL_OK)
+        st = sl_encoder_create(&ctx.enc, &err);
+    pthread_mutex_lock(&srv->lock);
+    if (st != SL_OK) {
+        srv->render_ready = -1;
+        snprintf(srv->render_fail, sizeof srv->render_fail, "%.250s", err.message);
+        pthread_cond_broadcast(&srv->wake);
+        pthread_mutex_unlock(&srv->lock);
+        sl_encoder_destroy(ctx.enc);
+        sl_gpu_destroy(ctx.gpu);
+        return NULL;
+    }
+    srv->render_ready = 1;
+    snprintf(srv->gpu_renderer, sizeof srv->gpu_renderer, "%s", sl_gpu_renderer(ctx.gpu));
+    pthread_cond_broadcast(&srv->wake);
+    sl_session_state *copy = malloc(sizeof *copy);
+    while (!srv->stop && copy) {
+        reap(srv);
+        double now = sl_server_now_ms();
+        double deadline = now + 1000.0;
+        enum job_kind kind = JOB_NONE;
+        sl_session *s = pick_job(srv, &ctx.rr, &kind, now, &deadline);
+        if (!s) {
+            double wait = deadline - now;
+            if (wait < 1)
+                wait = 1;
+            struct timespec ts;
+            clock_gettime(CLOCK_MONOTONIC, &ts);
+            long long ns = ts.tv_nsec + (long long)(wait * 1e6);
+            ts.tv_sec += (time_t)(ns / 1000000000LL);
+            ts.tv_nsec = (long)(ns % 1000000000LL);
+            pthread_cond_timedwait(&srv->wake, &srv->lock, &ts);
+            continue;
+        }
+        *copy = s->state;
+        int ids[SL_SESSION_MAX_SNAPSHOTS], nids = 0;
+        if (kind == JOB_SNAPSHOT) {
+            nids = s->snap_req_count;
+            memcpy(ids, s->snap_req, sizeof(int) * (size_t)nids);
+            s->snap_req_count = 0;
+        }
+        int interactive = 0;
+        if (kind == JOB_FRAME)
+            interactive = copy->phase != SL_PHASE_NONE && now < copy->camera_ms + copy->stream.still_delay_ms;
+        s->rendering = 1;
+        pthread_mutex_unlock(&srv->lock);
+        if (kind == JOB_SNAPSHOT)
+            do_snapshot(&ctx, s, copy, ids, nids);
+        else
+            do_frame(&ctx, s, copy, interactive);
+        lws_cancel_service(srv->lws);
+        pthread_mutex_lock(&srv->lock);
+        s->rendering = 0;
+    }
+    /* Shutdown: GL objects die on this thread; sessions are freed by the service thread. */
+    for (sl_session *s = srv->sessions; s; s = s->next) {
+        sl_pipeline_destroy(s->pipeline);
+        s->pipeline = NULL;
+    }
+    reap(srv);
+    pthread_mutex_unlock(&srv->lock);
+    free(copy);
+    free(ctx.rgba);
+    sl_encoder_destroy(ctx.enc);
+    sl_gpu_destroy(ctx.gpu);
+    return NULL;
+}
+
+sl_status sl_render_start(sl_server *srv, sl_err *err)
+{
+    if (pthread_create(&srv->render_thread, NULL, render_main, srv) != 0)
+        return sl_err_set(err, SL_ERR_NOMEM, "cannot start the render thread: %s", strerror(errno));
+    srv->render_started = 1;
+    pthread_mutex_lock(&srv->lock);
+    while (srv->render_ready == 0)
+        pthread_cond_wait(&srv->wake, &srv->lock);
+    int ok = srv->render_ready > 0;
+    pthread_mutex_unlock(&srv->lock);
+    if (!ok) {
+        pthread_join(srv->render_thread, NULL);
+        srv->render_started = 0;
+        return sl_err_set(err, SL_ERR_GPU, "render thread: %s", srv->render_fail);
+    }
+    return SL_OK;
+}
+
+void sl_render_stop(sl_server *srv)
+{
+    if (!srv->render_started)
+        return;
+    pthread_mutex_lock(&srv->lock);
+    srv->stop = 1;
+    pthread_cond_broadcast(&srv->wake);
+    pthread_mutex_unlock(&srv->lock);
+    pthread_join(srv->render_thread, NULL);
+    srv->render_started = 0;
+}

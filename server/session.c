@@ -1,0 +1,966 @@
+/* session.c — sessions, clients, control and the handling of every client message.
+ *
+ * A session is what a group of clients looks at: desired state (dataset,
+ * technique, params, camera, size, stream settings), a version bumped on
+ * every change, and the newest frame. The creator holds control; viewers
+ * who joined with the token see every change but their camera/set/scene/
+ * resize/load_view are refused until control moves to them (grant, release
+ * or the controller leaving). A session with no clients lives on for the
+ * grace period, then is doomed; the render thread frees it with its GL state.
+ * Flow control: state changes reach each client as one coalesced `state`
+ * patch (newest wins), frames as the session's latest frame, and only while
+ * the client has fewer than SL_PROTO_ACK_WINDOW unacknowledged frames.
+ * Runs on the lws service thread only; it writes shared session fields under
+ * srv->lock and reads them without it (it is their only writer).
+ */
+#include "sl_server.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/random.h>
+
+#include <libwebsockets.h>
+
+#include "core/sl_technique.h"
+#include "sl_params_json.h"
+#include "sl_scene.h"
+
+#define DEFAULT_CAMERA "{\"orbit\":{\"azimuth\":30,\"elevation\":20,\"distance\":2.5},\"fov_y\":45}"
+
+static void random_hex(char *out, int bytes)
+{
+    unsigned char buf[32];
+    if (getrandom(buf, (size_t)bytes, 0) != bytes) {
+        /* getrandom on Linux does not fail for <= 256 bytes once seeded; mix the clock in as a fallback. */
+        double t = sl_server_now_ms();
+        for (int i = 0; i < bytes; i++)
+            buf[i] = (unsigned char)((long long)(t * 1000.0) >> (i % 8) ^ (unsigned)rand());
+    }
+    for (int i = 0; i < bytes; i++)
+        snprintf(out + 2 * i, 3, "%02x", buf[i]);
+}
+
+/* ---------- outgoing messages ---------- */
+
+int sl_client_queue_text(sl_client *c, char *text)
+{
+    if (!text)
+        return -1;
+    if (c->text_count >= SL_CLIENT_MAX_TEXT) {
+        free(text);
+        c->close_after_send = 1;
+        lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"reply queue full", 16);
+        lws_set_timeout(c->wsi, PENDING_TIMEOUT_CLOSE_SEND, LWS_TO_KILL_ASYNC);
+        return -1;
+    }
+    size_t len = strlen(text);
+    uint8_t *buf = malloc(LWS_PRE + len);
+    if (!buf) {
+        free(text);
+        return -1;
+    }
+    memcpy(buf + LWS_PRE, text, len);
+    free(text);
+    int slot = (c->text_head + c->text_count) % SL_CLIENT_MAX_TEXT;
+    c->text[slot] = buf;
+    c->text_len[slot] = len;
+    c->text_count++;
+    lws_callback_on_writable(c->wsi);
+    return 0;
+}
+
+static char *print_and_free(cJSON *o)
+{
+    char *t = o ? cJSON_PrintUnformatted(o) : NULL;
+    cJSON_Delete(o);
+    return t;
+}
+
+static void send_error(sl_server *srv, sl_client *c, const char *code, const char *message, const char *field)
+{
+    pthread_mutex_lock(&srv->lock);
+    srv->metrics.errors_sent++;
+    pthread_mutex_unlock(&srv->lock);
+    sl_client_queue_text(c, sl_msg_error_text(code, message, field));
+}
+
+static cJSON *stream_json(const sl_stream_settings *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "interactive_scale", s->interactive_scale);
+    cJSON_AddNumberToObject(o, "interactive_quality", s->interactive_quality);
+    cJSON_AddStringToObject(o, "interactive_subsampling", s->interactive_420 ? "420" : "444");
+    cJSON_AddNumberToObject(o, "still_quality", s->still_quality);
+    cJSON_AddStringToObject(o, "still_subsampling", s->still_420 ? "420" : "444");
+    cJSON_AddNumberToObject(o, "still_delay_ms", s->still_delay_ms);
+    return o;
+}
+
+static cJSON *state_json(const sl_session *s)
+{
+    const sl_session_state *st = &s->state;
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "version", st->version);
+    cJSON_AddStringToObject(o, "dataset", st->dataset);
+    cJSON_AddStringToObject(o, "technique", st->technique);
+    cJSON_AddItemToObject(o, "params", sl_params_to_json(&st->params));
+    cJSON *cam = cJSON_Parse(st->camera_json);
+    cJSON_AddItemToObject(o, "camera", cam ? cam : cJSON_CreateNull());
+    cJSON_AddNumberToObject(o, "camera_seq", st->camera_seq);
+    cJSON_AddNumberToObject(o, "width", st->width);
+    cJSON_AddNumberToObject(o, "height", st->height);
+    cJSON_AddItemToObject(o, "background", cJSON_CreateFloatArray(st->background, 4));
+    cJSON_AddItemToObject(o, "stream", stream_json(&st->stream));
+    cJSON_AddNumberToObject(o, "controller", s->controller);
+    cJSON_AddItemToObject(o, "bounds", s->bounds ? cJSON_Duplicate(s->bounds, 1) : cJSON_CreateNull());
+    return o;
+}
+
+static void persist(sl_server *srv, sl_session *s)
+{
+    char *text = print_and_free(state_json(s));
+    sl_err err = {0};
+    if (text && sl_catalog_session_put(srv->db, s->id, text, &err) != SL_OK)
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+    free(text);
+}
+
+/* Merges patch (consumed) into every client's pending patch: newest value of each key wins. */
+static void broadcast_patch(sl_session *s, cJSON *patch)
+{
+    for (sl_client *c = s->clients; c; c = c->next) {
+        if (!c->patch)
+            c->patch = cJSON_CreateObject();
+        const cJSON *it;
+        cJSON_ArrayForEach(it, patch) {
+            cJSON *dup = cJSON_Duplicate(it, 1);
+            if (!dup)
+                continue;
+            if (cJSON_HasObjectItem(c->patch, it->string))
+                cJSON_ReplaceItemInObjectCaseSensitive(c->patch, it->string, dup);
+            else
+                cJSON_AddItemToObject(c->patch, it->string, dup);
+        }
+        c->patch_version = s->state.version;
+        lws_callback_on_writable(c->wsi);
+    }
+    cJSON_Delete(patch);
+}
+
+/* Bumps the version, wakes the render thread; caller holds srv->lock. */
+static void state_changed_locked(sl_server *srv, sl_session *s)
+{
+    s->state.version++;
+    pthread_cond_signal(&srv->wake);
+}
+
+/* ---------- sessions ---------- */
+
+/* The list is walked under the lock because the render thread unlinks doomed
+ * sessions; the pointer stays valid after unlock because only this thread dooms. */
+static sl_session *find_session(sl_server *srv, const char *id)
+{
+    sl_session *found = NULL;
+    pthread_mutex_lock(&srv->lock);
+    for (sl_session *s = srv->sessions; s && !found; s = s->next)
+        if (!s->doomed && strcmp(s->id, id) == 0)
+            found = s;
+    pthread_mutex_unlock(&srv->lock);
+    return found;
+}
+
+static sl_client *find_client(sl_session *s, int id)
+{
+    for (sl_client *c = s->clients; c; c = c->next)
+        if (c->id == id)
+            return c;
+    return NULL;
+}
+
+void sl_session_free(sl_session *s)
+{
+    if (!s)
+        return;
+    sl_frame_buf_unref(s->latest);
+    sl_frame_buf_unref(s->snap_ready);
+    free(s->info_bounds);
+    free(s->info_counts);
+    free(s->info_attrs);
+    cJSON_Delete(s->bounds);
+    free(s);
+}
+
+/* The first catalog dataset the technique accepts; fills the state's dataset fields. */
+static sl_status pick_default_dataset(sl_server *srv, const sl_technique *t, sl_session_state *st, sl_err *err)
+{
+    cJSON *list = sl_catalog_list_json(srv->db);
+    const cJSON *d;
+    sl_status rc = sl_err_set(err, SL_ERR_INVALID, "the catalog has no dataset that %s accepts", t->name);
+    cJSON_ArrayForEach(d, list) {
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(d, "name");
+        int is_file = 0, kind = 0;
+        if (srv->cfg.default_dataset && cJSON_IsString(name) && strcmp(name->valuestring, srv->cfg.default_dataset))
+            continue;
+        if (!cJSON_IsString(name) ||
+            sl_catalog_lookup(srv->db, name->valuestring, st->dataset_source, sizeof st->dataset_source, &is_file,
+                              &kind, err) != SL_OK)
+            continue;
+        if (!(t->dataset_kinds & (unsigned)kind))
+            continue;
+        snprintf(st->dataset, sizeof st->dataset, "%s", name->valuestring);
+        st->dataset_is_file = is_file;
+        st->dataset_kind = kind;
+        rc = SL_OK;
+        break;
+    }
+    cJSON_Delete(list);
+    return rc;
+}
+
+static sl_session *create_session(sl_server *srv, int width, int height, sl_err *err)
+{
+    /* Evict the oldest session without clients when at the cap. */
+    if (srv->session_count >= srv->cfg.max_sessions) {
+        sl_session *oldest = NULL;
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *s = srv->sessions; s; s = s->next)
+            if (!s->doomed && s->client_count == 0 && (!oldest || s->empty_since_ms < oldest->empty_since_ms))
+                oldest = s;
+        if (!oldest) {
+            pthread_mutex_unlock(&srv->lock);
+            sl_err_set(err, SL_ERR_LIMIT, "the server already has %d sessions (--max-sessions)", srv->cfg.max_sessions);
+            return NULL;
+        }
+        char id[sizeof oldest->id];
+        memcpy(id, oldest->id, sizeof id);
+        oldest->doomed = 1;   /* the render thread may free it from here on */
+        srv->session_count--;
+        pthread_cond_signal(&srv->wake);
+        pthread_mutex_unlock(&srv->lock);
+        sl_catalog_session_remove(srv->db, id, err);
+    }
+    sl_session *s = calloc(1, sizeof *s);
+    if (!s) {
+        sl_err_set(err, SL_ERR_NOMEM, "session allocation failed");
+        return NULL;
+    }
+    random_hex(s->id, 8);
+    random_hex(s->token, 16);
+    int tc = 0;
+    const sl_technique *const *techs = sl_technique_list(&tc);
+    sl_session_state *st = &s->state;
+    sl_status rc = SL_ERR_INVALID;
+    for (int i = 0; i < tc && rc != SL_OK; i++) {
+        rc = pick_default_dataset(srv, techs[i], st, err);
+        if (rc == SL_OK) {
+            snprintf(st->technique, sizeof st->technique, "%s", techs[i]->name);
+            sl_params_init(&st->params, techs[i]->params, techs[i]->param_count);
+        }
+    }
+    if (rc != SL_OK) {
+        free(s);
+        return NULL;
+    }
+    st->version = 1;
+    snprintf(st->camera_json, sizeof st->camera_json, "%s", DEFAULT_CAMERA);
+    st->width = width > 0 ? width : 640;
+    st->height = height > 0 ? height : 480;
+    st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
+    st->stream = (sl_stream_settings){.interactive_scale = 0.5, .interactive_quality = 60, .interactive_420 = 1,
+                                      .still_quality = 92, .still_420 = 0, .still_delay_ms = 200};
+    s->empty_since_ms = sl_server_now_ms();
+    pthread_mutex_lock(&srv->lock);
+    s->next = srv->sessions;
+    srv->sessions = s;
+    srv->session_count++;
+    pthread_cond_signal(&srv->wake);
+    pthread_mutex_unlock(&srv->lock);
+    persist(srv, s);
+    return s;
+}
+
+static void attach(sl_server *srv, sl_session *s, sl_client *c)
+{
+    c->session = s;
+    c->next = s->clients;
+    s->clients = c;
+    s->client_count++;
+    if (!s->controller)
+        s->controller = c->id;
+    c->hello_done = 1;
+    lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
+    cJSON *w = cJSON_CreateObject();
+    cJSON_AddStringToObject(w, "type", "welcome");
+    cJSON_AddNumberToObject(w, "version", SL_PROTO_VERSION);
+    cJSON_AddStringToObject(w, "session", s->id);
+    cJSON_AddStringToObject(w, "token", s->token);
+    cJSON_AddNumberToObject(w, "client", c->id);
+    cJSON_AddStringToObject(w, "role", s->controller == c->id ? "controller" : "viewer");
+    cJSON_AddItemToObject(w, "state", state_json(s));
+    cJSON_AddItemToObject(w, "techniques", cJSON_Duplicate(srv->techniques_json, 1));
+    cJSON_AddItemToObject(w, "datasets", sl_catalog_list_json(srv->db));
+    cJSON *lim = cJSON_AddObjectToObject(w, "limits");
+    cJSON_AddNumberToObject(lim, "max_message", SL_PROTO_MAX_MESSAGE);
+    cJSON_AddNumberToObject(lim, "max_message_before_hello", SL_PROTO_MAX_HELLO);
+    cJSON_AddNumberToObject(lim, "max_size", SL_PROTO_MAX_SIZE);
+    cJSON_AddNumberToObject(lim, "ack_window", SL_PROTO_ACK_WINDOW);
+    cJSON_AddNumberToObject(lim, "max_clients", srv->cfg.max_clients);
+    cJSON_AddNumberToObject(lim, "grace_s", srv->cfg.grace_s);
+    sl_client_queue_text(c, print_and_free(w));
+    /* A late joiner gets the latest frame at once: write_next sends it. */
+    lws_callback_on_writable(c->wsi);
+    (void)srv;
+}
+
+static void set_controller(sl_session *s, int id)
+{
+    s->controller = id;
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddNumberToObject(p, "controller", id);
+    broadcast_patch(s, p);
+}
+
+/* Control passes to the longest-connected other client (the list's tail), or nobody. */
+static void pass_control(sl_session *s, int leaving)
+{
+    int next = 0;
+    for (sl_client *c = s->clients; c; c = c->next)
+        if (c->id != leaving)
+            next = c->id;
+    set_controller(s, next);
+}
+
+/* ---------- message handlers ---------- */
+
+static int require_control(sl_server *srv, sl_client *c, const char *what)
+{
+    if (c->session->controller == c->id)
+        return 1;
+    char msg[160];
+    snprintf(msg, sizeof msg, "%s needs control of the session; send {\"type\":\"control\",\"action\":\"request\"}",
+             what);
+    send_error(srv, c, "not_controller", msg, "type");
+    return 0;
+}
+
+static int parse_camera(sl_server *srv, sl_client *c, const cJSON *cam, char out[SL_CAMERA_JSON_MAX])
+{
+    sl_err err = {0};
+    int is_orbit = 0;
+    sl_camera camera;
+    sl_orbit orbit;
+    if (sl_camera_json_parse(cam, &is_orbit, &camera, &orbit, &err) != SL_OK) {
+        send_error(srv, c, "bad_field", err.message, "camera");
+        return 0;
+    }
+    char *text = cJSON_PrintUnformatted(cam);
+    if (!text || strlen(text) >= SL_CAMERA_JSON_MAX) {
+        free(text);
+        send_error(srv, c, "bad_field", "camera object is longer than 1024 bytes", "camera");
+        return 0;
+    }
+    memcpy(out, text, strlen(text) + 1);
+    free(text);
+    return 1;
+}
+
+/* Applies a params patch to *params (all or nothing); on failure names the offending key. */
+static int apply_params(sl_server *srv, sl_client *c, sl_params *params, const cJSON *patch)
+{
+    sl_params copy = *params;
+    sl_err err = {0};
+    if (sl_params_apply_json(&copy, patch, &err) == SL_OK) {
+        *params = copy;
+        return 1;
+    }
+    char field[SL_PROTO_ID_MAX + 8] = "params";
+    const cJSON *it;
+    cJSON_ArrayForEach(it, patch) {
+        sl_params one = *params;
+        cJSON *single = cJSON_CreateObject();
+        cJSON_AddItemToObject(single, it->string, cJSON_Duplicate(it, 1));
+        sl_err e2 = {0};
+        sl_status bad = sl_params_apply_json(&one, single, &e2);
+        cJSON_Delete(single);
+        if (bad) {
+            snprintf(field, sizeof field, "params.%.56s", it->string);
+            break;
+        }
+    }
+    send_error(srv, c, "bad_param", err.message, field);
+    return 0;
+}
+
+static int parse_stream(sl_server *srv, sl_client *c, const cJSON *o, sl_stream_settings *out)
+{
+    sl_stream_settings s = *out;
+    const cJSON *it;
+    cJSON_ArrayForEach(it, o) {
+        const char *k = it->string;
+        char field[96];
+        snprintf(field, sizeof field, "stream.%.80s", k);
+        if (strcmp(k, "interactive_subsampling") == 0 || strcmp(k, "still_subsampling") == 0) {
+            int v = -1;
+            if (cJSON_IsString(it) && strcmp(it->valuestring, "420") == 0)
+                v = 1;
+            else if (cJSON_IsString(it) && strcmp(it->valuestring, "444") == 0)
+                v = 0;
+            if (v < 0) {
+                send_error(srv, c, "bad_field", "subsampling must be \"420\" or \"444\"", field);
+                return 0;
+            }
+            *(k[0] == 'i' ? &s.interactive_420 : &s.still_420) = v;
+            continue;
+        }
+        double lo, hi;
+        if (strcmp(k, "interactive_scale") == 0) { lo = 0.1; hi = 1.0; }
+        else if (strcmp(k, "interactive_quality") == 0 || strcmp(k, "still_quality") == 0) { lo = 1; hi = 100; }
+        else if (strcmp(k, "still_delay_ms") == 0) { lo = 0; hi = 10000; }
+        else {
+            send_error(srv, c, "bad_field", "unknown stream setting", field);
+            return 0;
+        }
+        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || it->valuedouble < lo || it->valuedouble > hi ||
+            (strcmp(k, "interactive_scale") != 0 && it->valuedouble != floor(it->valuedouble))) {
+            char msg[128];
+            snprintf(msg, sizeof msg, "%s must be a number in [%g, %g]", k, lo, hi);
+            send_error(srv, c, "bad_field", msg, field);
+            return 0;
+        }
+        if (strcmp(k, "interactive_scale") == 0) s.interactive_scale = it->valuedouble;
+        else if (strcmp(k, "interactive_quality") == 0) s.interactive_quality = (int)it->valuedouble;
+        else if (strcmp(k, "still_quality") == 0) s.still_quality = (int)it->valuedouble;
+        else s.still_delay_ms = (int)it->valuedouble;
+    }
+    *out = s;
+    return 1;
+}
+
+/* Switches dataset and/or technique (and optionally params and camera): scene and load_view. */
+static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const char *technique,
+                        const cJSON *params, const cJSON *camera)
+{
+    sl_session *s = c->session;
+    sl_session_state next = s->state;
+    sl_err err = {0};
+    if (dataset && dataset[0] && strcmp(dataset, next.dataset) != 0) {
+        if (sl_catalog_lookup(srv->db, dataset, next.dataset_source, sizeof next.dataset_source,
+                              &next.dataset_is_file, &next.dataset_kind, &err) != SL_OK) {
+            send_error(srv, c, "not_found", err.message, "dataset");
+            return;
+        }
+        snprintf(next.dataset, sizeof next.dataset, "%s", dataset);
+    }
+    const sl_technique *t = sl_technique_find(technique && technique[0] ? technique : next.technique);
+    if (!t) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "no technique named \"%.120s\"", technique ? technique : next.technique);
+        send_error(srv, c, "not_found", msg, "technique");
+        return;
+    }
+    if (!(t->dataset_kinds & (unsigned)next.dataset_kind)) {
+        char msg[300];
+        snprintf(msg, sizeof msg, "technique %s does not render %s datasets (dataset \"%.120s\")", t->name,
+                 sl_dataset_kind_name((sl_dataset_kind)next.dataset_kind), next.dataset);
+        send_error(srv, c, "bad_field", msg, technique && technique[0] ? "technique" : "dataset");
+        return;
+    }
+    if (strcmp(t->name, next.technique) != 0) {
+        snprintf(next.technique, sizeof next.technique, "%s", t->name);
+        sl_params_init(&next.params, t->params, t->param_count);
+    }
+    if (params && !apply_params(srv, c, &next.params, params))
+        return;
+    if (camera && !parse_camera(srv, c, camera, next.camera_json))
+        return;
+    next.phase = SL_PHASE_NONE;
+    if (strcmp(next.dataset, s->state.dataset) != 0) {
+        cJSON_Delete(s->bounds);   /* known again once the render thread has loaded it */
+        s->bounds = NULL;
+    }
+    pthread_mutex_lock(&srv->lock);
+    s->state = next;
+    state_changed_locked(srv, s);
+    pthread_mutex_unlock(&srv->lock);
+    cJSON *full = state_json(s);
+    cJSON_DeleteItemFromObjectCaseSensitive(full, "stream");
+    broadcast_patch(s, full);
+    persist(srv, s);
+}
+
+static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    if (m->version != SL_PROTO_VERSION) {
+        send_error(srv, c, "bad_version", "this server speaks protocol version 1", "version");
+        c->close_after_send = 1;
+        return;
+    }
+    sl_session *s;
+    if (m->session[0]) {
+        s = find_session(srv, m->session);
+        if (!s) {
+            send_error(srv, c, "unknown_session", "no such session (it may have expired)", "session");
+            c->close_after_send = 1;
+            return;
+        }
+        /* Compare every byte so timing does not reveal a matching prefix. */
+        size_t lt = strlen(s->token), lm = strlen(m->token);
+        unsigned diff = (unsigned)(lt ^ lm);
+        for (size_t i = 0; i < lt; i++)
+            diff |= (unsigned)(s->token[i] ^ (i < lm ? m->token[i] : 0));
+        if (diff) {
+            send_error(srv, c, "bad_token", "the join token does not match this session", "token");
+            c->close_after_send = 1;
+            return;
+        }
+    } else {
+        sl_err err = {0};
+        s = create_session(srv, m->width, m->height, &err);
+        if (!s) {
+            send_error(srv, c, "session_failed", err.message, "");
+            c->close_after_send = 1;
+            return;
+        }
+    }
+    attach(srv, s, c);
+}
+
+static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    sl_session_state next = s->state;
+    if (m->params && !apply_params(srv, c, &next.params, m->params))
+        return;
+    if (m->stream && !parse_stream(srv, c, m->stream, &next.stream))
+        return;
+    if (m->background) {
+        int i = 0;
+        const cJSON *v;
+        cJSON_ArrayForEach(v, m->background)
+            next.background[i++] = (float)v->valuedouble;
+    }
+    next.phase = SL_PHASE_NONE;
+    pthread_mutex_lock(&srv->lock);
+    s->state = next;
+    state_changed_locked(srv, s);
+    pthread_mutex_unlock(&srv->lock);
+    cJSON *p = cJSON_CreateObject();
+    if (m->params)
+        cJSON_AddItemToObject(p, "params", sl_params_to_json(&next.params));
+    if (m->stream)
+        cJSON_AddItemToObject(p, "stream", stream_json(&next.stream));
+    if (m->background)
+        cJSON_AddItemToObject(p, "background", cJSON_CreateFloatArray(next.background, 4));
+    broadcast_patch(s, p);
+}
+
+static void on_camera(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    char cam[SL_CAMERA_JSON_MAX];
+    if (!parse_camera(srv, c, m->camera, cam))
+        return;
+    pthread_mutex_lock(&srv->lock);
+    memcpy(s->state.camera_json, cam, sizeof cam);
+    s->state.camera_seq = (uint32_t)m->seq;
+    s->state.phase = m->phase;
+    s->state.camera_ms = sl_server_now_ms();
+    state_changed_locked(srv, s);
+    pthread_mutex_unlock(&srv->lock);
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddItemToObject(p, "camera", cJSON_Parse(cam));
+    cJSON_AddNumberToObject(p, "camera_seq", (double)m->seq);
+    broadcast_patch(s, p);
+}
+
+static void on_control(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    switch (m->action) {
+    case SL_CONTROL_REQUEST: {
+        if (!s->controller || s->controller == c->id) {
+            set_controller(s, c->id);
+            return;
+        }
+        sl_client *ctl = find_client(s, s->controller);
+        if (ctl) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddStringToObject(r, "type", "control_request");
+            cJSON_AddNumberToObject(r, "client", c->id);
+            sl_client_queue_text(ctl, print_and_free(r));
+        }
+        return;
+    }
+    case SL_CONTROL_GRANT:
+        if (!require_control(srv, c, "control grant"))
+            return;
+        if (!find_client(s, m->client)) {
+            send_error(srv, c, "not_found", "no client with that id in this session", "client");
+            return;
+        }
+        set_controller(s, m->client);
+        return;
+    case SL_CONTROL_RELEASE:
+        if (!require_control(srv, c, "control release"))
+            return;
+        pass_control(s, c->id);
+        return;
+    }
+}
+
+void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t len)
+{
+    sl_msg m;
+    char code[32], field[SL_PROTO_ID_MAX];
+    sl_err err = {0};
+    pthread_mutex_lock(&srv->lock);
+    srv->metrics.messages_in++;
+    pthread_mutex_unlock(&srv->lock);
+    if (sl_msg_parse(text, len, &m, code, field, &err) != SL_OK) {
+        send_error(srv, c, code, err.message, field);
+        if (!c->hello_done)
+            c->close_after_send = 1;
+        return;
+    }
+    if (!c->hello_done && m.type != SL_MSG_HELLO) {
+        send_error(srv, c, "hello_required", "the first message must be hello", "type");
+        c->close_after_send = 1;
+        sl_msg_deinit(&m);
+        return;
+    }
+    if (c->hello_done && m.type == SL_MSG_HELLO) {
+        send_error(srv, c, "bad_field", "hello was already received on this connection", "type");
+        sl_msg_deinit(&m);
+        return;
+    }
+    sl_session *s = c->session;
+    switch (m.type) {
+    case SL_MSG_HELLO:
+        on_hello(srv, c, &m);
+        break;
+    case SL_MSG_CAMERA:
+        if (require_control(srv, c, "camera"))
+            on_camera(srv, c, &m);
+        break;
+    case SL_MSG_SET:
+        if (require_control(srv, c, "set"))
+            on_set(srv, c, &m);
+        break;
+    case SL_MSG_SCENE:
+        if (require_control(srv, c, "scene"))
+            apply_scene(srv, c, m.dataset, m.technique, m.params, m.camera);
+        break;
+    case SL_MSG_RESIZE:
+        if (require_control(srv, c, "resize")) {
+            pthread_mutex_lock(&srv->lock);
+            s->state.width = m.width;
+            s->state.height = m.height;
+            s->state.phase = SL_PHASE_NONE;
+            state_changed_locked(srv, s);
+            pthread_mutex_unlock(&srv->lock);
+            cJSON *p = cJSON_CreateObject();
+            cJSON_AddNumberToObject(p, "width", m.width);
+            cJSON_AddNumberToObject(p, "height", m.height);
+            broadcast_patch(s, p);
+        }
+        break;
+    case SL_MSG_LIST_DATASETS: {
+        cJSON *r = cJSON_CreateObject();
+        cJSON_AddStringToObject(r, "type", "datasets");
+        cJSON_AddItemToObject(r, "datasets", sl_catalog_list_json(srv->db));
+        sl_client_queue_text(c, print_and_free(r));
+        break;
+    }
+    case SL_MSG_LIST_VIEWS: {
+        cJSON *r = cJSON_CreateObject();
+        cJSON_AddStringToObject(r, "type", "views");
+        cJSON_AddItemToObject(r, "views", sl_catalog_list_views_json(srv->db));
+        sl_client_queue_text(c, print_and_free(r));
+        break;
+    }
+    case SL_MSG_SAVE_VIEW: {
+        char *params = print_and_free(sl_params_to_json(&s->state.params));
+        sl_status st = sl_catalog_save_view(srv->db, m.name, s->state.dataset, s->state.technique,
+                                            params ? params : "{}", s->state.camera_json, &err);
+        free(params);
+        if (st) {
+            send_error(srv, c, "internal", err.message, "name");
+        } else {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddStringToObject(r, "type", "view_saved");
+            cJSON_AddStringToObject(r, "name", m.name);
+            sl_client_queue_text(c, print_and_free(r));
+        }
+        break;
+    }
+    case SL_MSG_LOAD_VIEW: {
+        if (!require_control(srv, c, "load_view"))
+            break;
+        cJSON *v = NULL;
+        if (sl_catalog_load_view(srv->db, m.name, &v, &err) != SL_OK || !v) {
+            send_error(srv, c, "not_found", v ? err.message : "no saved view with that name", "name");
+            cJSON_Delete(v);
+            break;
+        }
+        const cJSON *ds = cJSON_GetObjectItemCaseSensitive(v, "dataset");
+        const cJSON *tq = cJSON_GetObjectItemCaseSensitive(v, "technique");
+        const cJSON *pa = cJSON_GetObjectItemCaseSensitive(v, "params");
+        const cJSON *ca = cJSON_GetObjectItemCaseSensitive(v, "camera");
+        apply_scene(srv, c, cJSON_IsString(ds) ? ds->valuestring : NULL, cJSON_IsString(tq) ? tq->valuestring : NULL,
+                    cJSON_IsObject(pa) ? pa : NULL, cJSON_IsObject(ca) ? ca : NULL);
+        cJSON_Delete(v);
+        break;
+    }
+    case SL_MSG_ACK: {
+        int keep = 0;
+        for (int i = 0; i < c->inflight_count; i++)
+            if (c->inflight[i] > m.frame_id)
+                c->inflight[keep++] = c->inflight[i];
+        c->inflight_count = keep;
+        lws_callback_on_writable(c->wsi);
+        break;
+    }
+    case SL_MSG_SNAPSHOT:
+        pthread_mutex_lock(&srv->lock);
+        if (s->snap_req_count < SL_SESSION_MAX_SNAPSHOTS) {
+            s->snap_req[s->snap_req_count++] = c->id;
+            pthread_cond_signal(&srv->wake);
+            pthread_mutex_unlock(&srv->lock);
+        } else {
+            pthread_mutex_unlock(&srv->lock);
+            send_error(srv, c, "busy", "too many snapshots pending in this session; retry later", "type");
+        }
+        break;
+    case SL_MSG_CONTROL:
+        on_control(srv, c, &m);
+        break;
+    case SL_MSG_PING: {
+        cJSON *r = cJSON_CreateObject();
+        cJSON_AddStringToObject(r, "type", "pong");
+        cJSON_AddNumberToObject(r, "seq", (double)m.seq);
+        sl_client_queue_text(c, print_and_free(r));
+        break;
+    }
+    default:
+        break;
+    }
+    sl_msg_deinit(&m);
+}
+
+void sl_sessions_on_close(sl_server *srv, sl_client *c)
+{
+    sl_session *s = c->session;
+    if (s) {
+        for (sl_client **pp = &s->clients; *pp; pp = &(*pp)->next)
+            if (*pp == c) {
+                *pp = c->next;
+                break;
+            }
+        s->client_count--;
+        if (s->controller == c->id)
+            pass_control(s, c->id);
+        if (s->client_count == 0)
+            s->empty_since_ms = sl_server_now_ms();
+        pthread_mutex_lock(&srv->lock);
+        for (int i = 0; i < s->snap_req_count; i++)
+            if (s->snap_req[i] == c->id)
+                s->snap_req[i] = 0;
+        pthread_mutex_unlock(&srv->lock);
+    }
+    for (int i = 0; i < c->text_count; i++)
+        free(c->text[(c->text_head + i) % SL_CLIENT_MAX_TEXT]);
+    c->text_count = 0;
+    cJSON_Delete(c->patch);
+    c->patch = NULL;
+    sl_frame_buf_unref(c->snapshot);
+    c->snapshot = NULL;
+    free(c->rx);
+    c->rx = NULL;
+    c->session = NULL;
+}
+
+void sl_sessions_on_wake(sl_server *srv)
+{
+    pthread_mutex_lock(&srv->lock);
+    for (sl_session *s = srv->sessions; s; s = s->next) {
+        if (s->doomed)
+            continue;
+        if (s->latest && s->latest->header.frame_id != s->dispatched_frame) {
+            s->dispatched_frame = s->latest->header.frame_id;
+            for (sl_client *c = s->clients; c; c = c->next)
+                lws_callback_on_writable(c->wsi);
+        }
+        if (s->snap_ready) {
+            for (int i = 0; i < s->snap_ready_count; i++) {
+                sl_client *c = s->snap_ready_ids[i] ? find_client(s, s->snap_ready_ids[i]) : NULL;
+                if (c && !c->snapshot) {
+                    sl_frame_buf_ref(s->snap_ready);
+                    c->snapshot = s->snap_ready;
+                    lws_callback_on_writable(c->wsi);
+                }
+            }
+            sl_frame_buf_unref(s->snap_ready);
+            s->snap_ready = NULL;
+            s->snap_ready_count = 0;
+        }
+        for (sl_client *c = s->clients; c; c = c->next) {
+            if (c->error_seq != s->error_seq) {
+                c->error_seq = s->error_seq;
+                srv->metrics.errors_sent++;
+                sl_client_queue_text(c, sl_msg_error_text("render_failed", s->error_text, ""));
+            }
+        }
+    }
+    pthread_mutex_unlock(&srv->lock);
+    /* Dataset descriptions from the render thread: taken under the lock, written
+     * to the catalog and broadcast outside it (SQLite must not stall rendering). */
+    for (;;) {
+        sl_session *s = NULL;
+        char *bounds = NULL, *counts = NULL, *attrs = NULL, name[SL_PROTO_NAME_MAX];
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *t = srv->sessions; t && !s; t = t->next) {
+            if (!t->doomed && t->info_pending) {
+                s = t;
+                s->info_pending = 0;
+                bounds = s->info_bounds;
+                counts = s->info_counts;
+                attrs = s->info_attrs;
+                s->info_bounds = s->info_counts = s->info_attrs = NULL;
+                memcpy(name, s->info_dataset, sizeof name);
+            }
+        }
+        pthread_mutex_unlock(&srv->lock);
+        if (!s)
+            break;
+        sl_err err = {0};
+        if (bounds && counts && attrs)
+            sl_catalog_set_info(srv->db, name, bounds, counts, attrs, &err);
+        cJSON *b = bounds ? cJSON_Parse(bounds) : NULL;
+        if (b && strcmp(name, s->state.dataset) == 0) {
+            cJSON_Delete(s->bounds);
+            s->bounds = b;
+            cJSON *p = cJSON_CreateObject();
+            cJSON_AddItemToObject(p, "bounds", cJSON_Duplicate(b, 1));
+            broadcast_patch(s, p);
+        } else {
+            cJSON_Delete(b);
+        }
+        free(bounds);
+        free(counts);
+        free(attrs);
+    }
+}
+
+static int write_buf(struct lws *wsi, uint8_t *data, size_t len, enum lws_write_protocol proto)
+{
+    int n = lws_write(wsi, data, len, proto);
+    return n < (int)len ? -1 : 0;
+}
+
+int sl_client_write_next(sl_server *srv, sl_client *c)
+{
+    if (c->text_count > 0) {
+        int slot = c->text_head;
+        uint8_t *buf = c->text[slot];
+        size_t len = c->text_len[slot];
+        c->text[slot] = NULL;
+        c->text_head = (c->text_head + 1) % SL_CLIENT_MAX_TEXT;
+        c->text_count--;
+        int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
+        free(buf);
+        if (rc)
+            return -1;
+        if (c->text_count == 0 && c->close_after_send) {
+            lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"refused", 7);
+            return -1;
+        }
+        lws_callback_on_writable(c->wsi);
+        return 0;
+    }
+    if (c->close_after_send) {
+        lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"refused", 7);
+        return -1;
+    }
+    sl_session *s = c->session;
+    if (!s)
+        return 0;
+    if (c->patch) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "type", "state");
+        cJSON_AddNumberToObject(o, "version", c->patch_version);
+        cJSON_AddItemToObject(o, "patch", c->patch);
+        c->patch = NULL;
+        char *text = print_and_free(o);
+        if (!text)
+            return -1;
+        size_t len = strlen(text);
+        uint8_t *buf = malloc(LWS_PRE + len);
+        if (!buf) {
+            free(text);
+            return -1;
+        }
+        memcpy(buf + LWS_PRE, text, len);
+        free(text);
+        int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
+        free(buf);
+        lws_callback_on_writable(c->wsi);
+        return rc;
+    }
+    if (c->snapshot) {
+        sl_frame_buf *f = c->snapshot;
+        c->snapshot = NULL;
+        int rc = write_buf(c->wsi, f->data, f->size, LWS_WRITE_BINARY);
+        sl_frame_buf_unref(f);
+        lws_callback_on_writable(c->wsi);
+        return rc;
+    }
+    sl_frame_buf *f = NULL;
+    pthread_mutex_lock(&srv->lock);
+    if (s->latest && s->latest->header.frame_id > c->sent_frame_id && c->inflight_count < SL_PROTO_ACK_WINDOW) {
+        f = s->latest;
+        sl_frame_buf_ref(f);
+        if (c->sent_frame_id)
+            srv->metrics.frames_dropped += f->header.frame_id - c->sent_frame_id - 1;
+        srv->metrics.frames_sent++;
+        srv->metrics.bytes_sent += f->size;
+    }
+    pthread_mutex_unlock(&srv->lock);
+    if (!f)
+        return 0;
+    c->sent_frame_id = f->header.frame_id;
+    c->inflight[c->inflight_count++] = f->header.frame_id;
+    int rc = write_buf(c->wsi, f->data, f->size, LWS_WRITE_BINARY);
+    sl_frame_buf_unref(f);
+    return rc;
+}
+
+void sl_sessions_sweep(sl_server *srv)
+{
+    double now = sl_server_now_ms();
+    pthread_mutex_lock(&srv->lock);
+    for (sl_session *s = srv->sessions; s; s = s->next) {
+        if (s->doomed || s->client_count > 0 || now - s->empty_since_ms < srv->cfg.grace_s * 1000.0)
+            continue;
+        sl_err err = {0};
+        sl_catalog_session_remove(srv->db, s->id, &err);
+        s->doomed = 1;
+        srv->session_count--;
+        pthread_cond_signal(&srv->wake);
+    }
+    pthread_mutex_unlock(&srv->lock);
+}
+
+void sl_sessions_destroy_all(sl_server *srv)
+{
+    pthread_mutex_lock(&srv->lock);
+    sl_session *s = srv->sessions;
+    srv->sessions = NULL;
+    pthread_mutex_unlock(&srv->lock);
+    while (s) {
+        sl_session *next = s->next;
+        sl_session_free(s);
+        s = next;
+    }
+}

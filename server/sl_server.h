@@ -1,0 +1,277 @@
+/* sl_server.h — the internal contract between sightline-server's parts.
+ *
+ *   main.c     arguments, the `catalog` subcommand, start and stop
+ *   ws.c       lws context, WebSocket protocol, static files (service thread)
+ *   session.c  sessions, clients, control, grace period, message handling
+ *              (service thread)
+ *   render.c   the render thread: owns sl_gpu and one sl_pipeline per session
+ *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
+ *   catalog.c  SQLite catalog (service thread and the CLI)
+ *   http.c     /healthz and /metrics bodies (service thread)
+ *
+ * Threads: the lws service thread owns sockets, clients, the catalog; the
+ * render thread owns every GL object. They share only the fields marked
+ * "[lock]" below, guarded by sl_server.lock; the render thread waits on
+ * sl_server.wake and wakes the service thread with lws_cancel_service.
+ * Fields marked "[service]" or "[render]" belong to that thread alone.
+ * Nothing is queued without a bound: state is "newest wins", a session keeps
+ * one latest frame, a client keeps at most SL_CLIENT_MAX_TEXT replies.
+ */
+#ifndef SL_SERVER_H
+#define SL_SERVER_H
+
+#include <pthread.h>
+#include <sqlite3.h>
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include <cjson/cJSON.h>
+
+#include "core/sl_params.h"
+#include "core/sl_status.h"
+#include "sl_protocol.h"
+
+struct lws;
+struct lws_context;
+typedef struct sl_pipeline sl_pipeline;
+typedef struct sl_dataset sl_dataset;
+
+#define SL_SERVER_MAX_ORIGINS 8
+#define SL_SERVER_MAX_DATA_DIRS 8
+#define SL_CLIENT_MAX_TEXT 32          /* queued replies per client; more closes it */
+#define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
+#define SL_CAMERA_JSON_MAX 1024
+#define SL_SOURCE_MAX 2048
+
+typedef struct sl_server_config {
+    int port;                      /* 0: any free port (printed on stdout) */
+    const char *bind;              /* default 127.0.0.1 */
+    const char *db_path;
+    const char *web_dir;           /* default <source>/web or ./web */
+    const char *data_dirs[SL_SERVER_MAX_DATA_DIRS];
+    int data_dir_count;
+    const char *origins[SL_SERVER_MAX_ORIGINS];  /* extra allowed Origin values */
+    int origin_count;
+    int max_clients;               /* default 64 */
+    int max_sessions;              /* default 32 */
+    int grace_s;                   /* default 300 */
+    const char *egl_device;        /* NULL: auto */
+    const char *default_dataset;   /* NULL: the first catalog dataset the first technique accepts */
+} sl_server_config;
+
+/* ---- frames (encoder.c) ---- */
+
+/* A reference-counted encoded message: LWS_PRE bytes of headroom, the
+ * 40-byte frame header, the payload. Immutable once published. */
+typedef struct sl_frame_buf {
+    atomic_int refs;
+    sl_frame_header header;
+    size_t size;          /* header + payload bytes, starting at data */
+    uint8_t *data;        /* = mem + LWS_PRE */
+    size_t capacity;      /* bytes available at data */
+    uint8_t mem[];
+} sl_frame_buf;
+
+sl_frame_buf *sl_frame_buf_create(size_t capacity);
+void sl_frame_buf_ref(sl_frame_buf *f);
+void sl_frame_buf_unref(sl_frame_buf *f);   /* NULL is fine */
+
+typedef struct sl_encoder sl_encoder;
+sl_status sl_encoder_create(sl_encoder **out, sl_err *err);
+void sl_encoder_destroy(sl_encoder *e);
+/* Encodes bottom-up RGBA rows (GL's order, no flip copy) into a new frame
+ * buffer whose header fields other than payload_bytes/quality/subsampling/
+ * width/height/kind/encode_ms are filled by the caller afterwards. */
+sl_status sl_encoder_jpeg(sl_encoder *e, const uint8_t *rgba_bottom_up, int width, int height, int quality,
+                          int subsampling_420, sl_frame_buf **out, double *encode_ms, sl_err *err);
+sl_status sl_encoder_png(const uint8_t *rgba_top_down, int width, int height, sl_frame_buf **out,
+                         double *encode_ms, sl_err *err);
+
+/* ---- sessions (session.c) ---- */
+
+typedef struct sl_stream_settings {
+    double interactive_scale;      /* 0.5: half size while dragging */
+    int interactive_quality;       /* 60 */
+    int interactive_420;           /* 1 */
+    int still_quality;             /* 92 */
+    int still_420;                 /* 0 */
+    int still_delay_ms;            /* 200 */
+} sl_stream_settings;
+
+/* What a session should show: copied whole by the render thread. */
+typedef struct sl_session_state {
+    uint32_t version;
+    char dataset[SL_PROTO_NAME_MAX];
+    char dataset_source[SL_SOURCE_MAX];  /* generator JSON or absolute file path */
+    int dataset_is_file;
+    int dataset_kind;
+    char technique[SL_PROTO_NAME_MAX];
+    sl_params params;
+    char camera_json[SL_CAMERA_JSON_MAX];/* validated camera object */
+    uint32_t camera_seq;
+    sl_camera_phase phase;
+    double camera_ms;                    /* time of the last camera message */
+    int width, height;
+    float background[4];
+    sl_stream_settings stream;
+} sl_session_state;
+
+typedef struct sl_client sl_client;
+typedef struct sl_session sl_session;
+
+struct sl_client {                  /* [service] */
+    struct lws *wsi;
+    int id;
+    sl_session *session;            /* NULL before hello */
+    int hello_done;
+    char *rx;                       /* message being reassembled */
+    size_t rx_len, rx_cap;
+    uint8_t *text[SL_CLIENT_MAX_TEXT]; /* ring of LWS_PRE-prefixed texts */
+    size_t text_len[SL_CLIENT_MAX_TEXT];
+    int text_head, text_count;
+    cJSON *patch;                   /* coalesced state patch not yet sent */
+    uint32_t patch_version;
+    uint32_t sent_frame_id;         /* newest frame id sent */
+    uint32_t inflight[SL_PROTO_ACK_WINDOW]; /* sent, unacknowledged frame ids */
+    int inflight_count;
+    sl_frame_buf *snapshot;         /* PNG waiting to be sent */
+    uint32_t error_seq;             /* render errors already reported */
+    int close_after_send;
+    sl_client *next;                /* in session->clients */
+};
+
+struct sl_session {
+    char id[33], token[33];                  /* immutable */
+    sl_session_state state;                  /* [lock] desired state */
+    uint32_t rendered_version;               /* [lock] written by render thread */
+    int rendered_interactive;                /* [lock] */
+    int rendering;                           /* [lock] render thread works on it */
+    sl_frame_buf *latest;                    /* [lock] newest frame, owned ref */
+    uint32_t next_frame_id;                  /* [lock] */
+    int snap_req[SL_SESSION_MAX_SNAPSHOTS];  /* [lock] client ids waiting for a PNG */
+    int snap_req_count;
+    sl_frame_buf *snap_ready;                /* [lock] rendered PNG */
+    int snap_ready_ids[SL_SESSION_MAX_SNAPSHOTS];
+    int snap_ready_count;
+    char error_text[512];                    /* [lock] last render error */
+    uint32_t error_seq;                      /* [lock] */
+    int doomed;                              /* [lock] expired; render thread frees */
+    char *info_bounds, *info_counts, *info_attrs; /* [lock] set by the render thread after a load */
+    char info_dataset[SL_PROTO_NAME_MAX];    /* [lock] which dataset the info describes */
+    int info_pending;                        /* [lock] not yet taken by the service thread */
+    sl_session *next;                        /* [lock] in server->sessions */
+    /* [service] */
+    sl_client *clients;
+    int client_count;
+    int controller;                          /* client id, 0 = nobody */
+    double empty_since_ms;
+    uint32_t dispatched_frame;               /* newest frame id dispatched to clients */
+    cJSON *bounds;                           /* [[x,y,z],[x,y,z]] of the loaded dataset, or NULL */
+    /* [render] */
+    sl_pipeline *pipeline;
+    char loaded_source[SL_SOURCE_MAX];
+};
+
+/* ---- metrics (http.c) ---- */
+
+#define SL_HIST_BUCKETS 12
+typedef struct sl_histogram {
+    uint64_t counts[SL_HIST_BUCKETS];       /* cumulative at render time */
+    double sum;
+    uint64_t total;
+} sl_histogram;
+
+typedef struct sl_metrics {                  /* [lock] */
+    uint64_t frames_rendered, frames_sent, frames_dropped, frames_failed;
+    uint64_t snapshots, bytes_sent, messages_in, errors_sent;
+    sl_histogram render_ms, encode_ms;
+} sl_metrics;
+
+void sl_histogram_add(sl_histogram *h, double ms);
+
+/* ---- the server ---- */
+
+typedef struct sl_server {
+    sl_server_config cfg;
+    struct lws_context *lws;
+    sqlite3 *db;                             /* [service] */
+    pthread_mutex_t lock;
+    pthread_cond_t wake;                     /* render thread waits here */
+    sl_session *sessions;                    /* [lock] */
+    int session_count;                       /* [lock] live (not doomed) */
+    int client_count;                        /* [service] */
+    int next_client_id;                      /* [service] */
+    sl_metrics metrics;                      /* [lock] */
+    int stop;                                /* [lock] */
+    int render_ready;                        /* [lock] 1 up, -1 failed */
+    char gpu_renderer[128];                  /* [lock] */
+    char render_fail[256];                   /* [lock] */
+    pthread_t render_thread;
+    int render_started;
+    double start_ms;
+    cJSON *techniques_json;                  /* [service] cached list with schemas */
+} sl_server;
+
+/* session.c (service thread unless noted) */
+void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t len);
+void sl_sessions_on_close(sl_server *srv, sl_client *c);
+void sl_sessions_on_wake(sl_server *srv);     /* dispatch frames, snapshots, errors */
+void sl_sessions_sweep(sl_server *srv);       /* expire sessions past the grace period */
+void sl_sessions_destroy_all(sl_server *srv); /* at shutdown, after the render thread ended */
+void sl_session_free(sl_session *s);          /* render thread or shutdown; not the pipeline */
+/* Queues a text message for c (takes ownership of text). Returns -1 when the
+ * client's queue is full (the client is then closed). */
+int sl_client_queue_text(sl_client *c, char *text);
+/* Called from ws.c on writable: sends one message. Returns -1 to close. */
+int sl_client_write_next(sl_server *srv, sl_client *c);
+
+/* render.c */
+sl_status sl_render_start(sl_server *srv, sl_err *err);
+void sl_render_stop(sl_server *srv);
+
+/* catalog.c — every query uses bound parameters. */
+sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err);
+void sl_catalog_close(sqlite3 *db);
+/* Registers the built-in generator datasets (when absent) and scans dirs. */
+sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err);
+/* Adds a file; refused when outside every data_dir (after realpath). */
+sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *data_dirs, int dir_count,
+                              sl_err *err);
+sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count,
+                          int *added, sl_err *err);
+sl_status sl_catalog_remove(sqlite3 *db, const char *name, sl_err *err);
+/* Registers a named generator call (validated by generating it once). */
+sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *generator_json, sl_err *err);
+/* Bounds, counts and attribute names of a dataset as malloc'd JSON texts (no
+ * database: callable from the render thread). */
+void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, char **attrs);
+/* Fills bounds/counts/attributes of a row that has none yet (built-ins). */
+sl_status sl_catalog_set_info(sqlite3 *db, const char *name, const char *bounds, const char *counts,
+                              const char *attrs, sl_err *err);
+/* JSON array of {name, kind, source, bounds, counts, attributes, ...}. */
+cJSON *sl_catalog_list_json(sqlite3 *db);
+/* Fills source (generator JSON or path), is_file and kind; SL_ERR_INVALID when unknown. */
+sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t source_size, int *is_file,
+                            int *kind, sl_err *err);
+sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *dataset, const char *technique,
+                               const char *params_json, const char *camera_json, sl_err *err);
+/* *view receives {name, dataset, technique, params, camera} or NULL when absent. */
+sl_status sl_catalog_load_view(sqlite3 *db, const char *name, cJSON **view, sl_err *err);
+cJSON *sl_catalog_list_views_json(sqlite3 *db);
+sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *state_json, sl_err *err);
+sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err);
+/* Sessions live in memory; rows left by a previous run are removed at start. */
+sl_status sl_catalog_sessions_clear(sqlite3 *db, sl_err *err);
+
+/* http.c */
+char *sl_http_healthz(sl_server *srv, int *status);
+char *sl_http_metrics(sl_server *srv);
+
+/* ws.c */
+sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
+void sl_ws_run(sl_server *srv, volatile int *interrupted);
+void sl_ws_destroy(sl_server *srv);
+
+double sl_server_now_ms(void);
+
+#endif

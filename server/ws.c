@@ -1,0 +1,282 @@
+/* ws.c — the libwebsockets side: one context, static files, /healthz, /metrics, /ws.
+ *
+ * Everything here runs on the lws service thread (the thread that calls
+ * sl_ws_run). WebSocket upgrades are accepted only on path /ws with
+ * subprotocol sightline.v1 and an Origin that is absent (non-browser
+ * clients), equal to the served origin (http://<Host>) or in the allow-list.
+ * Incoming messages are reassembled up to SL_PROTO_MAX_HELLO bytes before
+ * hello and SL_PROTO_MAX_MESSAGE after; a larger one closes only that
+ * connection with 1008 (policy violation). Writes happen only in
+ * SERVER_WRITEABLE, one message per callback (session.c chooses which).
+ * The render thread wakes this thread with lws_cancel_service, which arrives
+ * as LWS_CALLBACK_EVENT_WAIT_CANCELLED. Never calls GL.
+ */
+#include "sl_server.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <libwebsockets.h>
+
+typedef struct ws_pss {
+    sl_client *client;
+} ws_pss;
+
+typedef struct http_pss {
+    char *body;
+    size_t len;
+    int status;
+    const char *mime;
+} http_pss;
+
+static struct {
+    lws_sorted_usec_list_t sul;
+    sl_server *srv;
+} sweep_timer;
+
+static sl_server *server_of(struct lws *wsi)
+{
+    return lws_context_user(lws_get_context(wsi));
+}
+
+static int origin_allowed(sl_server *srv, struct lws *wsi)
+{
+    char origin[256], host[256], served[300];
+    if (lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) <= 0)
+        return 1; /* not a browser: nothing to protect against */
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0) {
+        snprintf(served, sizeof served, "http://%s", host);
+        if (strcmp(origin, served) == 0)
+            return 1;
+    }
+    for (int i = 0; i < srv->cfg.origin_count; i++)
+        if (strcmp(origin, srv->cfg.origins[i]) == 0)
+            return 1;
+    lwsl_notice("refused WebSocket upgrade from origin %s\n", origin);
+    return 0;
+}
+
+static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+    ws_pss *pss = user;
+    sl_server *srv = server_of(wsi);
+    switch (reason) {
+    case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION: {
+        char uri[64];
+        if (lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI) <= 0 || strcmp(uri, "/ws") != 0)
+            return 1;
+        if (!origin_allowed(srv, wsi))
+            return 1;
+        if (srv->client_count >= srv->cfg.max_clients) {
+            lwsl_notice("refused WebSocket: %d clients (--max-clients)\n", srv->client_count);
+            return 1;
+        }
+        return 0;
+    }
+    case LWS_CALLBACK_ESTABLISHED: {
+        sl_client *c = calloc(1, sizeof *c);
+        if (!c)
+            return -1;
+        c->wsi = wsi;
+        c->id = ++srv->next_client_id;
+        pss->client = c;
+        /* hello must come within 10 s (cleared in session.c when it does). */
+        lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, 10);
+        pthread_mutex_lock(&srv->lock);
+        srv->client_count++;
+        pthread_mutex_unlock(&srv->lock);
+        return 0;
+    }
+    case LWS_CALLBACK_CLOSED:
+        if (pss->client) {
+            sl_sessions_on_close(srv, pss->client);
+            free(pss->client);
+            pss->client = NULL;
+            pthread_mutex_lock(&srv->lock);
+            srv->client_count--;
+            pthread_mutex_unlock(&srv->lock);
+        }
+        return 0;
+    case LWS_CALLBACK_RECEIVE: {
+        sl_client *c = pss->client;
+        if (!c)
+            return -1;
+        if (c->close_after_send)
+            return 0; /* refused: only the pending error is still sent */
+        size_t limit = c->hello_done ? SL_PROTO_MAX_MESSAGE : SL_PROTO_MAX_HELLO;
+        size_t remaining = lws_remaining_packet_payload(wsi);
+        if (c->rx_len + len + remaining > limit) {
+            char reason_text[64];
+            int n = snprintf(reason_text, sizeof reason_text, "message over %zu bytes", limit);
+            lws_close_reason(wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)reason_text, (size_t)n);
+            return -1;
+        }
+        if (c->rx_len + len + 1 > c->rx_cap) {
+            size_t cap = c->rx_len + len + remaining + 1;
+            char *p = realloc(c->rx, cap);
+            if (!p)
+                return -1;
+            c->rx = p;
+            c->rx_cap = cap;
+        }
+        memcpy(c->rx + c->rx_len, in, len);
+        c->rx_len += len;
+        if (lws_is_final_fragment(wsi) && lws_remaining_packet_payload(wsi) == 0) {
+            size_t n = c->rx_len;
+            c->rx_len = 0;
+            if (lws_frame_is_binary(wsi)) {
+                sl_client_queue_text(c, sl_msg_error_text("bad_json", "binary messages are not accepted; send JSON text", ""));
+                return 0;
+            }
+            sl_sessions_on_text(srv, c, c->rx, n);
+        }
+        return 0;
+    }
+    case LWS_CALLBACK_SERVER_WRITEABLE:
+        if (!pss->client)
+            return -1;
+        return sl_client_write_next(srv, pss->client);
+    case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
+        sl_sessions_on_wake(srv);
+        return 0;
+    default:
+        return 0;
+    }
+}
+
+static int callback_http_extras(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+    http_pss *pss = user;
+    sl_server *srv = server_of(wsi);
+    uint8_t headers[LWS_PRE + 1024], *start = headers + LWS_PRE, *p = start, *end = headers + sizeof headers - 1;
+    switch (reason) {
+    case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+        return 1; /* WebSocket only on sightline.v1 */
+    case LWS_CALLBACK_HTTP: {
+        char uri[32] = "";
+        lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI);
+        free(pss->body);
+        pss->body = NULL;
+        if (strcmp(uri, "/healthz") == 0) {
+            pss->body = sl_http_healthz(srv, &pss->status);
+            pss->mime = "application/json";
+        } else if (strcmp(uri, "/metrics") == 0) {
+            pss->body = sl_http_metrics(srv);
+            pss->status = 200;
+            pss->mime = "text/plain; version=0.0.4";
+        } else {
+            if (lws_return_http_status(wsi, HTTP_STATUS_NOT_FOUND, NULL))
+                return -1;
+            return lws_http_transaction_completed(wsi) ? -1 : 0;
+        }
+        if (!pss->body)
+            return -1;
+        pss->len = strlen(pss->body);
+        if (lws_add_http_common_headers(wsi, (unsigned)pss->status, pss->mime, pss->len, &p, end) ||
+            lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL, (const unsigned char *)"no-store", 8,
+                                         &p, end) ||
+            lws_finalize_write_http_header(wsi, start, &p, end))
+            return 1;
+        lws_callback_on_writable(wsi);
+        return 0;
+    }
+    case LWS_CALLBACK_HTTP_WRITEABLE: {
+        if (!pss->body)
+            return -1;
+        uint8_t *buf = malloc(LWS_PRE + pss->len + 1);
+        if (!buf)
+            return -1;
+        memcpy(buf + LWS_PRE, pss->body, pss->len);
+        int n = lws_write(wsi, buf + LWS_PRE, pss->len, LWS_WRITE_HTTP_FINAL);
+        free(buf);
+        free(pss->body);
+        pss->body = NULL;
+        if (n < (int)pss->len)
+            return -1;
+        if (lws_http_transaction_completed(wsi))
+            return -1;
+        return 0;
+    }
+    case LWS_CALLBACK_CLOSED_HTTP:
+        free(pss->body);
+        pss->body = NULL;
+        return 0;
+    default:
+        return lws_callback_http_dummy(wsi, reason, user, in, len);
+    }
+}
+
+/* protocols[0] handles plain HTTP (files, 404s) and refuses WebSocket
+ * upgrades that name no subprotocol. */
+static int callback_default(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+    if (reason == LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION)
+        return 1;
+    return lws_callback_http_dummy(wsi, reason, user, in, len);
+}
+
+static const struct lws_protocols protocols[] = {
+    {"http", callback_default, 0, 0, 0, NULL, 0},
+    {"http-extras", callback_http_extras, sizeof(http_pss), 0, 0, NULL, 0},
+    {SL_PROTO_SUBPROTOCOL, callback_ws, sizeof(ws_pss), 16384, 0, NULL, 0},
+    {NULL, NULL, 0, 0, 0, NULL, 0},
+};
+
+static struct lws_http_mount mount_metrics = {
+    .mountpoint = "/metrics", .mountpoint_len = 8, .origin = "http-extras", .origin_protocol = LWSMPRO_CALLBACK,
+};
+static struct lws_http_mount mount_healthz = {
+    .mount_next = &mount_metrics, .mountpoint = "/healthz", .mountpoint_len = 8, .origin = "http-extras",
+    .origin_protocol = LWSMPRO_CALLBACK,
+};
+static struct lws_http_mount mount_root = {
+    .mount_next = &mount_healthz, .mountpoint = "/", .mountpoint_len = 1, .def = "index.html",
+    .origin_protocol = LWSMPRO_FILE,
+};
+
+static void sweep_cb(lws_sorted_usec_list_t *sul)
+{
+    (void)sul;
+    sl_sessions_sweep(sweep_timer.srv);
+    lws_sul_schedule(sweep_timer.srv->lws, 0, &sweep_timer.sul, sweep_cb, LWS_US_PER_SEC);
+}
+
+sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
+{
+    lws_set_log_level(LLL_ERR | LLL_WARN, NULL);
+    mount_root.origin = srv->cfg.web_dir;
+    struct lws_context_creation_info info;
+    memset(&info, 0, sizeof info);
+    info.port = srv->cfg.port;
+    info.iface = srv->cfg.bind;
+    info.protocols = protocols;
+    info.mounts = &mount_root;
+    info.user = srv;
+    info.options = LWS_SERVER_OPTION_HTTP_HEADERS_SECURITY_BEST_PRACTICES_ENFORCE |
+                   LWS_SERVER_OPTION_VALIDATE_UTF8;
+    srv->lws = lws_create_context(&info);
+    if (!srv->lws)
+        return sl_err_set(err, SL_ERR_IO, "cannot listen on %s:%d (libwebsockets context creation failed)",
+                          srv->cfg.bind, srv->cfg.port);
+    struct lws_vhost *vh = lws_get_vhost_by_name(srv->lws, "default");
+    *port = vh ? lws_get_vhost_listen_port(vh) : srv->cfg.port;
+    sweep_timer.srv = srv;
+    lws_sul_schedule(srv->lws, 0, &sweep_timer.sul, sweep_cb, LWS_US_PER_SEC);
+    return SL_OK;
+}
+
+void sl_ws_run(sl_server *srv, volatile int *interrupted)
+{
+    while (!*interrupted)
+        if (lws_service(srv->lws, 0) < 0)
+            break;
+}
+
+void sl_ws_destroy(sl_server *srv)
+{
+    if (!srv->lws)
+        return;
+    lws_context_destroy(srv->lws);
+    srv->lws = NULL;
+}

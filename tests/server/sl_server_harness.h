@@ -1,0 +1,429 @@
+/* sl_server_harness.h — start a private sightline-server for a test or benchmark,
+ * and talk to it as a protocol client.
+ *
+ * harness_start makes a temporary directory (catalog, empty data dir),
+ * registers a small generated dataset "tiny" (so sessions load in
+ * milliseconds even under ASan), starts $SIGHTLINE_BINARY_DIR/bin/sightline-server
+ * on 127.0.0.1 with --port 0 and reads the chosen port from its stdout.
+ * harness_stop sends SIGTERM and returns the exit status, so a leak (ASan)
+ * or a crash at shutdown fails the test. tclient wraps sl_wsclient: it
+ * parses text messages into cJSON, records every binary frame (header +
+ * payload copy) and acks frames when auto_ack is set. Loopback only.
+ * One thread per tclient; header-only (static functions) for tests and bench.
+ */
+#ifndef SL_SERVER_HARNESS_H
+#define SL_SERVER_HARNESS_H
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "sl_protocol.h"
+#include "sl_wsclient.h"
+
+#define HARNESS_TINY "{\"generator\":\"tornado\",\"lines\":40,\"points\":40,\"seed\":3}"
+
+typedef struct harness {
+    pid_t pid;
+    int port;
+    int out_fd;
+    char dir[256];
+    char db[300];
+    char exe[1024];
+} harness;
+
+static __attribute__((unused)) double harness_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static __attribute__((unused)) int harness_run_wait(char *const argv[])
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        int devnull = open("/dev/null", O_WRONLY);
+        if (devnull >= 0)
+            dup2(devnull, 1);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) < 0)
+        return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* extra: NULL-terminated extra server arguments (may be NULL). Returns 0 on success. */
+static __attribute__((unused)) int harness_start(harness *h, const char *const *extra)
+{
+    memset(h, 0, sizeof *h);
+    h->pid = -1;
+    const char *bin = getenv("SIGHTLINE_BINARY_DIR");
+    const char *src = getenv("SIGHTLINE_SOURCE_DIR");
+    snprintf(h->exe, sizeof h->exe, "%s/bin/sightline-server", bin ? bin : "build");
+    snprintf(h->dir, sizeof h->dir, "/tmp/sl-server-test-XXXXXX");
+    if (!mkdtemp(h->dir)) {
+        fprintf(stderr, "harness: mkdtemp failed: %s\n", strerror(errno));
+        return -1;
+    }
+    char data[300], web[1024];
+    snprintf(data, sizeof data, "%s/data", h->dir);
+    mkdir(data, 0755);
+    snprintf(h->db, sizeof h->db, "%s/catalog.db", h->dir);
+    snprintf(web, sizeof web, "%s/web", src ? src : ".");
+    char *reg[] = {h->exe, "catalog", "add-generator", "tiny", HARNESS_TINY, "--db", h->db, "--data-dir", data, NULL};
+    int rc = harness_run_wait(reg);
+    if (rc != 0) {
+        fprintf(stderr, "harness: catalog add-generator exited %d\n", rc);
+        return -1;
+    }
+    int pipefd[2];
+    if (pipe(pipefd) != 0)
+        return -1;
+    const char *argv[40] = {h->exe, "--port", "0", "--bind", "127.0.0.1", "--db", h->db, "--data-dir", data,
+                            "--web-dir", web, "--default-dataset", "tiny"};
+    int argc = 13;
+    for (int i = 0; extra && extra[i] && argc < 38; i++)
+        argv[argc++] = extra[i];
+    argv[argc] = NULL;
+    char log[400];
+    snprintf(log, sizeof log, "%s/server.log", h->dir);
+    /* LeakSanitizer's dynamic-TLS scan sometimes reads a stale block after
+     * Mesa's driver is dlclose()d at eglTerminate and crashes ("Tracer caught
+     * signal 11", "DTLS ... at 0x...15e"), so the server runs with use_tls=0.
+     * Without the TLS root set LSan can only report more, never less; what it
+     * then reports in addition are the dynamic loader's own TLS blocks, so the
+     * server gets tests/lsan.supp plus one line for ld-linux. */
+    char supp[400], line[512];
+    snprintf(supp, sizeof supp, "%s/lsan.supp", h->dir);
+    char lead_supp[1024];
+    snprintf(lead_supp, sizeof lead_supp, "%s/tests/lsan.supp", src ? src : ".");
+    FILE *in = fopen(lead_supp, "r"), *out = fopen(supp, "w");
+    while (in && out && fgets(line, sizeof line, in))
+        fputs(line, out);
+    if (out) {
+        fputs("leak:ld-linux-x86-64.so.2\n", out);
+        fclose(out);
+    }
+    if (in)
+        fclose(in);
+    const char *lsan = getenv("LSAN_OPTIONS");
+    char lsan_opts[1024];
+    snprintf(lsan_opts, sizeof lsan_opts, "%s%ssuppressions=%s:use_tls=0", lsan ? lsan : "", lsan && lsan[0] ? ":" : "",
+             supp);
+    h->pid = fork();
+    if (h->pid == 0) {
+        setenv("LSAN_OPTIONS", lsan_opts, 1);
+        int lfd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (lfd >= 0)
+            dup2(lfd, 2);
+        dup2(pipefd[1], 1);
+        close(pipefd[0]);
+        close(pipefd[1]);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    close(pipefd[1]);
+    h->out_fd = pipefd[0];
+    if (h->pid < 0)
+        return -1;
+    char buf[4096];
+    size_t len = 0;
+    double deadline = harness_now_ms() + 60000;
+    while (harness_now_ms() < deadline && len + 1 < sizeof buf) {
+        struct pollfd pfd = {.fd = h->out_fd, .events = POLLIN};
+        if (poll(&pfd, 1, 200) <= 0)
+            continue;
+        ssize_t n = read(h->out_fd, buf + len, sizeof buf - 1 - len);
+        if (n <= 0)
+            break;
+        len += (size_t)n;
+        buf[len] = 0;
+        char *p = strstr(buf, "listening on http://127.0.0.1:");
+        if (p && strchr(p, '\n')) {
+            h->port = atoi(p + strlen("listening on http://127.0.0.1:"));
+            return h->port > 0 ? 0 : -1;
+        }
+    }
+    fprintf(stderr, "harness: server did not report its port; output: %.*s\n", (int)len, buf);
+    return -1;
+}
+
+/* The server's stderr is kept in dir/server.log. LeakSanitizer reports
+ * whose every allocation is called from "<unknown module>" come from Mesa's
+ * driver, which eglTerminate unloads before the report (so lsan.supp cannot
+ * name it; sightline-render shows the same 112 bytes). Such a report is
+ * forgiven; any leak with a frame in our code is not. Returns 1 when the log
+ * shows only forgivable leaks. */
+static __attribute__((unused)) int harness_only_driver_leaks(const char *log_path)
+{
+    FILE *f = fopen(log_path, "r");
+    if (!f)
+        return 0;
+    char line[1024];
+    int leaks = 0, foreign = 0, ours = 0, in_report = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (strstr(line, "ERROR: LeakSanitizer"))
+            in_report = 1, leaks = 1;
+        if (!in_report)
+            continue;
+        if (strstr(line, "ERROR: AddressSanitizer") || strstr(line, "runtime error"))
+            ours++;
+        if (strstr(line, "    #1 ")) {
+            if (strstr(line, "<unknown module>"))
+                foreign++;
+            else
+                ours++;
+        }
+    }
+    fclose(f);
+    return leaks && foreign > 0 && ours == 0;
+}
+
+static __attribute__((unused)) void harness_dump_log(const harness *h)
+{
+    char path[400], line[1024];
+    snprintf(path, sizeof path, "%s/server.log", h->dir);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return;
+    while (fgets(line, sizeof line, f))
+        fprintf(stderr, "[server] %s", line);
+    fclose(f);
+}
+
+/* Stops the server; returns its exit status (0 = clean, or only Mesa's
+ * unloaded-driver leak), or -1 when it had to be killed. */
+static __attribute__((unused)) int harness_stop(harness *h)
+{
+    int result = -1;
+    if (h->pid > 0) {
+        kill(h->pid, SIGTERM);
+        double deadline = harness_now_ms() + 20000;
+        int status = 0;
+        for (;;) {
+            pid_t r = waitpid(h->pid, &status, WNOHANG);
+            if (r == h->pid) {
+                result = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+                break;
+            }
+            if (harness_now_ms() > deadline) {
+                kill(h->pid, SIGKILL);
+                waitpid(h->pid, &status, 0);
+                break;
+            }
+            usleep(20000);
+        }
+        h->pid = -1;
+        char log[400];
+        snprintf(log, sizeof log, "%s/server.log", h->dir);
+        harness_dump_log(h);
+        if (result != 0 && result != -1 && harness_only_driver_leaks(log)) {
+            fprintf(stderr, "harness: server exit %d is LeakSanitizer's report of Mesa's unloaded driver only; accepted\n", result);
+            result = 0;
+        }
+    }
+    if (h->out_fd > 0)
+        close(h->out_fd);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", h->dir);
+    if (strncmp(h->dir, "/tmp/sl-server-test-", 20) == 0 && system(cmd) != 0)
+        fprintf(stderr, "harness: could not remove %s\n", h->dir);
+    return result;
+}
+
+/* ---- protocol client ---- */
+
+typedef struct tframe {
+    sl_frame_header h;
+    uint8_t *payload;     /* owned copy */
+    double arrival_ms;
+} tframe;
+
+#define TCLIENT_KEEP_FRAMES 4
+
+typedef struct tclient {
+    sl_wsclient *ws;
+    int auto_ack;
+    int closed, close_code;
+    int frames;                    /* binary frames received */
+    tframe last;                   /* newest frame */
+    uint32_t frame_ids[256];       /* ids of the first 256 frames */
+    uint32_t max_frame_id;
+    char session[64], token[64];
+    int client_id;
+    cJSON *welcome;
+    sl_err err;
+} tclient;
+
+static __attribute__((unused)) int tclient_connect(tclient *c, int port, const char *origin)
+{
+    memset(c, 0, sizeof *c);
+    return sl_wsclient_connect("127.0.0.1", port, "/ws", SL_PROTO_SUBPROTOCOL, origin, 10000, &c->ws, &c->err) == SL_OK
+               ? 0 : -1;
+}
+
+static __attribute__((unused)) void tclient_close(tclient *c)
+{
+    sl_wsclient_destroy(c->ws);
+    c->ws = NULL;
+    free(c->last.payload);
+    c->last.payload = NULL;
+    cJSON_Delete(c->welcome);
+    c->welcome = NULL;
+}
+
+static __attribute__((unused)) int tclient_send(tclient *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static __attribute__((unused)) int tclient_send(tclient *c, const char *fmt, ...)
+{
+    char buf[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    if (n < 0 || n >= (int)sizeof buf)
+        return -1;
+    return sl_wsclient_send_text(c->ws, buf, (size_t)n, &c->err) == SL_OK ? 0 : -1;
+}
+
+/* Receives one message. Returns 1 text (*json set, caller frees), 2 frame (c->last updated),
+ * 0 closed, -1 timeout or error. */
+static __attribute__((unused)) int tclient_next(tclient *c, int timeout_ms, cJSON **json)
+{
+    if (json)
+        *json = NULL;
+    if (c->closed)
+        return 0;
+    sl_ws_kind kind;
+    const uint8_t *data;
+    size_t size;
+    int code = 0;
+    if (sl_wsclient_recv(c->ws, timeout_ms, &kind, &data, &size, &code, &c->err) != SL_OK) {
+        if (!sl_wsclient_timed_out(c->ws))
+            c->closed = 1;
+        return -1;
+    }
+    if (kind == SL_WS_CLOSED) {
+        c->closed = 1;
+        c->close_code = code;
+        return 0;
+    }
+    if (kind == SL_WS_TEXT) {
+        cJSON *j = cJSON_ParseWithLength((const char *)data, size);
+        if (json)
+            *json = j;
+        else
+            cJSON_Delete(j);
+        return 1;
+    }
+    sl_frame_header h;
+    if (sl_frame_header_read(data, size, &h, &c->err) != SL_OK)
+        return -1;
+    if (h.kind == SL_FRAME_JPEG) {
+        if (c->frames < 256)
+            c->frame_ids[c->frames] = h.frame_id;
+        c->frames++;
+        if (h.frame_id > c->max_frame_id)
+            c->max_frame_id = h.frame_id;
+    }
+    free(c->last.payload);
+    c->last.h = h;
+    c->last.arrival_ms = harness_now_ms();
+    c->last.payload = malloc(h.payload_bytes ? h.payload_bytes : 1);
+    if (c->last.payload)
+        memcpy(c->last.payload, data + SL_FRAME_HEADER_SIZE, h.payload_bytes);
+    if (c->auto_ack && h.kind == SL_FRAME_JPEG)
+        tclient_send(c, "{\"type\":\"ack\",\"frame\":%u}", h.frame_id);
+    return 2;
+}
+
+static __attribute__((unused)) const char *json_type(const cJSON *j)
+{
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(j, "type");
+    return cJSON_IsString(t) ? t->valuestring : "";
+}
+
+/* Waits for a text message of the given type (frames and other texts are consumed). */
+static __attribute__((unused)) cJSON *tclient_wait_type(tclient *c, const char *type, int timeout_ms)
+{
+    double deadline = harness_now_ms() + timeout_ms;
+    while (harness_now_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(c, (int)(deadline - harness_now_ms()) + 1, &j);
+        if (r == 1 && strcmp(json_type(j), type) == 0)
+            return j;
+        cJSON_Delete(j);
+        if (r == 0 || (r < 0 && c->closed))
+            return NULL;
+    }
+    return NULL;
+}
+
+/* Waits for a JPEG frame whose camera_seq >= seq and (still_only) not interactive. Returns 0 on success. */
+static __attribute__((unused)) int tclient_wait_frame(tclient *c, uint32_t seq, int still_only, int timeout_ms)
+{
+    double deadline = harness_now_ms() + timeout_ms;
+    while (harness_now_ms() < deadline) {
+        int r = tclient_next(c, (int)(deadline - harness_now_ms()) + 1, NULL);
+        if (r == 2 && c->last.h.kind == SL_FRAME_JPEG && c->last.h.camera_seq >= seq &&
+            (!still_only || !(c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE)))
+            return 0;
+        if (r == 0 || (r < 0 && c->closed))
+            return -1;
+    }
+    return -1;
+}
+
+/* hello (new session when session is NULL); fills session/token/client_id. Returns 0 on welcome. */
+static __attribute__((unused)) int tclient_hello(tclient *c, const char *session, const char *token, int w, int h)
+{
+    int rc;
+    if (session)
+        rc = tclient_send(c, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\",\"width\":%d,\"height\":%d}",
+                          session, token, w, h);
+    else
+        rc = tclient_send(c, "{\"type\":\"hello\",\"version\":1,\"width\":%d,\"height\":%d}", w, h);
+    if (rc)
+        return -1;
+    cJSON *wel = NULL;
+    double deadline = harness_now_ms() + 20000;
+    while (!wel && harness_now_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(c, 20000, &j);
+        if (r == 1 && (strcmp(json_type(j), "welcome") == 0 || strcmp(json_type(j), "error") == 0))
+            wel = j;
+        else
+            cJSON_Delete(j);
+        if (r <= 0)
+            break;
+    }
+    if (!wel || strcmp(json_type(wel), "welcome") != 0) {
+        cJSON_Delete(wel);
+        return -1;
+    }
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(wel, "session");
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(wel, "token");
+    const cJSON *id = cJSON_GetObjectItemCaseSensitive(wel, "client");
+    if (cJSON_IsString(s))
+        snprintf(c->session, sizeof c->session, "%s", s->valuestring);
+    if (cJSON_IsString(t))
+        snprintf(c->token, sizeof c->token, "%s", t->valuestring);
+    c->client_id = cJSON_IsNumber(id) ? id->valueint : 0;
+    c->welcome = wel;
+    return 0;
+}
+
+#endif

@@ -1,0 +1,648 @@
+/* test_server_protocol.c — the sightline.v1 protocol against a running sightline-server.
+ *
+ * Starts a private server (sl_server_harness.h) on a free loopback port and
+ * checks, each with assertions that fail on a wrong server: hello/welcome;
+ * frames arrive, carry a valid header and decode to the session size; a
+ * camera change gives a different image; dragging gives half-size
+ * interactive frames then a full-size still; malformed JSON, unknown type,
+ * unknown and out-of-range parameters each give an `error` and the
+ * connection keeps working; oversize messages close only that connection
+ * (1008); a wrong token is refused; two clients of one session see each
+ * other's changes and the same frame ids; viewers are refused until granted
+ * control; the ack window holds; snapshots are PNGs; views save and load;
+ * scene switches; the Origin check; /healthz and /metrics; and a session
+ * outlives its clients for the grace period, then expires. The server must
+ * exit cleanly (status 0, so no ASan leak report) at the end.
+ */
+#include <math.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <arpa/inet.h>
+
+#include "sl_server_harness.h"
+#include "sl_test.h"
+#include "image/sl_image.h"
+
+#define W 128
+#define H 96
+#define T 20000   /* generous per-step timeout (ASan + llvmpipe on 2 busy cores) */
+
+static sl_image decode_last(tclient *c)
+{
+    sl_image img = {0};
+    sl_err err;
+    if (sl_jpeg_decode(c->last.payload, c->last.h.payload_bytes, &img, &err) != SL_OK)
+        fprintf(stderr, "decode failed: %s\n", err.message);
+    return img;
+}
+
+/* Mean absolute difference per channel of two same-size images; -1 on size mismatch. */
+static double mean_diff(const sl_image *a, const sl_image *b)
+{
+    if (!a->rgba || !b->rgba || a->width != b->width || a->height != b->height)
+        return -1;
+    double sum = 0;
+    size_t n = (size_t)a->width * (size_t)a->height * 4;
+    for (size_t i = 0; i < n; i++)
+        sum += fabs((double)a->rgba[i] - (double)b->rgba[i]);
+    return sum / (double)n;
+}
+
+/* Fraction of pixels that differ from the top-left (background) pixel by more than 24 in any channel. */
+static double foreground_fraction(const sl_image *img)
+{
+    if (!img->rgba)
+        return 0;
+    size_t n = (size_t)img->width * (size_t)img->height, fg = 0;
+    const uint8_t *bg = img->rgba;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *p = img->rgba + 4 * i;
+        if (abs(p[0] - bg[0]) > 24 || abs(p[1] - bg[1]) > 24 || abs(p[2] - bg[2]) > 24)
+            fg++;
+    }
+    return (double)fg / (double)n;
+}
+
+static int error_is(cJSON *j, const char *code, const char *field)
+{
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(j, "code");
+    const cJSON *f = cJSON_GetObjectItemCaseSensitive(j, "field");
+    int ok = j && cJSON_IsString(c) && strcmp(c->valuestring, code) == 0 &&
+             (!field || (cJSON_IsString(f) && strcmp(f->valuestring, field) == 0));
+    if (!ok) {
+        char *t = j ? cJSON_PrintUnformatted(j) : NULL;
+        fprintf(stderr, "expected error %s/%s, got %s\n", code, field ? field : "*", t ? t : "(nothing)");
+        free(t);
+    }
+    return ok;
+}
+
+/* The connection still answers: ping -> pong with the same seq. */
+static int still_usable(tclient *c, int seq)
+{
+    if (tclient_send(c, "{\"type\":\"ping\",\"seq\":%d}", seq))
+        return 0;
+    cJSON *p = tclient_wait_type(c, "pong", T);
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(p, "seq");
+    int ok = p && cJSON_IsNumber(s) && s->valueint == seq;
+    cJSON_Delete(p);
+    return ok;
+}
+
+static int http_get(int port, const char *path, char *out, size_t out_size)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    char req[256];
+    int n = snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n", path, port);
+    if (write(fd, req, (size_t)n) != n) {
+        close(fd);
+        return -1;
+    }
+    size_t len = 0;
+    double deadline = harness_now_ms() + 5000;
+    while (len + 1 < out_size && harness_now_ms() < deadline) {
+        struct pollfd pfd = {.fd = fd, .events = POLLIN};
+        if (poll(&pfd, 1, 200) <= 0)
+            continue;
+        ssize_t r = read(fd, out + len, out_size - 1 - len);
+        if (r <= 0)
+            break;
+        len += (size_t)r;
+    }
+    out[len] = 0;
+    close(fd);
+    return atoi(out + 9); /* "HTTP/1.1 200" */
+}
+
+/* Waits for a state patch whose `key` is the string `value`; returns its version (0 on timeout). */
+static uint32_t wait_patch(tclient *c, const char *key, const char *value)
+{
+    double deadline = harness_now_ms() + T;
+    while (harness_now_ms() < deadline) {
+        cJSON *m = tclient_wait_type(c, "state", T);
+        if (!m)
+            return 0;
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), key);
+        uint32_t version = (uint32_t)cJSON_GetObjectItemCaseSensitive(m, "version")->valuedouble;
+        int hit = cJSON_IsString(v) && strcmp(v->valuestring, value) == 0;
+        cJSON_Delete(m);
+        if (hit)
+            return version;
+    }
+    return 0;
+}
+
+/* Waits for a still frame that shows state version >= version. */
+static int wait_version(tclient *c, uint32_t version)
+{
+    double deadline = harness_now_ms() + T;
+    while (harness_now_ms() < deadline) {
+        if (tclient_wait_frame(c, 0, 1, T) != 0)
+            return -1;
+        if (c->last.h.state_version >= version)
+            return 0;
+    }
+    return -1;
+}
+
+static double metric(const char *text, const char *name)
+{
+    char key[128];
+    snprintf(key, sizeof key, "\n%s ", name);
+    const char *p = strstr(text, key);
+    return p ? atof(p + strlen(key)) : -1;
+}
+
+/* First int or float parameter of the current technique's schema: name, min, max. */
+static int pick_numeric_param(const cJSON *welcome, char *name, size_t size, double *lo, double *hi, int *is_int)
+{
+    const cJSON *state = cJSON_GetObjectItemCaseSensitive(welcome, "state");
+    const cJSON *tech = cJSON_GetObjectItemCaseSensitive(state, "technique");
+    const cJSON *t;
+    cJSON_ArrayForEach(t, cJSON_GetObjectItemCaseSensitive(welcome, "techniques")) {
+        const cJSON *tn = cJSON_GetObjectItemCaseSensitive(t, "name");
+        if (!cJSON_IsString(tn) || !cJSON_IsString(tech) || strcmp(tn->valuestring, tech->valuestring) != 0)
+            continue;
+        const cJSON *p;
+        cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(t, "params")) {
+            const cJSON *type = cJSON_GetObjectItemCaseSensitive(p, "type");
+            if (cJSON_IsString(type) && (strcmp(type->valuestring, "int") == 0 || strcmp(type->valuestring, "float") == 0)) {
+                snprintf(name, size, "%s", cJSON_GetObjectItemCaseSensitive(p, "name")->valuestring);
+                *lo = cJSON_GetObjectItemCaseSensitive(p, "min")->valuedouble;
+                *hi = cJSON_GetObjectItemCaseSensitive(p, "max")->valuedouble;
+                *is_int = strcmp(type->valuestring, "int") == 0;
+                return 0;
+            }
+        }
+    }
+    return -1;
+}
+
+int main(void)
+{
+    harness h;
+    const char *extra[] = {"--grace", "2", NULL};
+    if (harness_start(&h, extra) != 0) {
+        SL_CHECK(!"server started");
+        harness_stop(&h);
+        SL_TEST_END();
+    }
+    printf("server on port %d\n", h.port);
+
+    /* --- hello / welcome --- */
+    tclient a;
+    SL_CHECK(tclient_connect(&a, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&a, NULL, NULL, W, H) == 0);
+    SL_CHECK(strlen(a.session) == 16 && strlen(a.token) == 32);
+    SL_CHECK(a.client_id > 0);
+    const cJSON *wst = cJSON_GetObjectItemCaseSensitive(a.welcome, "state");
+    SL_CHECK(cJSON_GetObjectItemCaseSensitive(wst, "width")->valueint == W);
+    SL_CHECK(strcmp(cJSON_GetObjectItemCaseSensitive(wst, "dataset")->valuestring, "tiny") == 0);
+    SL_CHECK(strcmp(cJSON_GetObjectItemCaseSensitive(a.welcome, "role")->valuestring, "controller") == 0);
+    SL_CHECK(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a.welcome, "techniques")) >= 1);
+    SL_CHECK(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a.welcome, "datasets")) >= 2);
+    SL_CHECK(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "limits"), "ack_window")
+                 ->valueint == 2);
+    a.auto_ack = 1;
+
+    /* --- first frame arrives, header valid, decodes to the session size, shows something --- */
+    SL_CHECK(tclient_wait_frame(&a, 0, 1, T) == 0);
+    SL_CHECK(a.last.h.width == W && a.last.h.height == H);
+    SL_CHECK(a.last.h.quality == 92 && a.last.h.subsampling == 0);
+    SL_CHECK(a.last.h.state_version >= 1 && a.last.h.frame_id >= 1);
+    sl_image first = decode_last(&a);
+    SL_CHECK(first.width == W && first.height == H);
+    double fg = foreground_fraction(&first);
+    SL_CHECK_MSG(fg > 0.01 && fg < 0.95, "foreground fraction %.3f", fg);
+
+    /* --- a camera change produces a different frame --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":5,\"camera\":{\"orbit\":{\"azimuth\":120,\"elevation\":-30,\"distance\":2}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&a, 5, 1, T) == 0);
+    SL_CHECK(a.last.h.camera_seq == 5);
+    sl_image second = decode_last(&a);
+    double d = mean_diff(&first, &second);
+    SL_CHECK_MSG(d > 1.0, "mean abs difference after a camera change %.3f", d);
+
+    /* --- dragging: half-size interactive frames, then a full-size still once the
+     *     session's still_delay_ms (set to 1500 here, a stream setting) has passed --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"stream\":{\"still_delay_ms\":1500}}") == 0);
+    cJSON *sp = tclient_wait_type(&a, "state", T);
+    const cJSON *sd = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(sp, "patch"), "stream"), "still_delay_ms");
+    SL_CHECK(sd && sd->valueint == 1500);
+    cJSON_Delete(sp);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"stream\":{\"still_delay_ms\":-1}}") == 0);
+    cJSON *se = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(se, "bad_field", "stream.still_delay_ms"));
+    cJSON_Delete(se);
+    double move_sent = harness_now_ms();
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":6,\"phase\":\"move\",\"camera\":{\"orbit\":{\"azimuth\":140,\"elevation\":-20,\"distance\":2}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&a, 6, 0, T) == 0);
+    int saw_interactive = (a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE) != 0;
+    if (saw_interactive) {
+        SL_CHECK(a.last.h.width == W / 2 && a.last.h.height == H / 2);
+        SL_CHECK(a.last.h.quality == 60 && a.last.h.subsampling == 1);
+        sl_image half = decode_last(&a);
+        SL_CHECK(half.width == W / 2);
+        sl_image_deinit(&half);
+    }
+    SL_CHECK_MSG(saw_interactive, "first frame after a move was not interactive (flags %u)", a.last.h.flags);
+    SL_CHECK(tclient_wait_frame(&a, 6, 1, T) == 0);
+    SL_CHECK(a.last.h.width == W && !(a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE));
+    SL_CHECK_MSG(a.last.arrival_ms - move_sent >= 1450, "still frame %.0f ms after the move (delay 1500)",
+                 a.last.arrival_ms - move_sent);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"stream\":{\"still_delay_ms\":200}}") == 0);
+
+    /* --- malformed JSON, unknown type, bad parameter: error, connection stays usable --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",") == 0);
+    cJSON *e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "bad_json", NULL));
+    cJSON_Delete(e);
+    SL_CHECK(still_usable(&a, 1));
+    SL_CHECK(tclient_send(&a, "{\"type\":\"teleport\"}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "unknown_type", "type"));
+    cJSON_Delete(e);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"params\":{\"no_such_param\":1}}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "bad_param", "params.no_such_param"));
+    cJSON_Delete(e);
+    char pname[64];
+    double plo = 0, phi = 0;
+    int pint = 0;
+    SL_CHECK(pick_numeric_param(a.welcome, pname, sizeof pname, &plo, &phi, &pint) == 0);
+    char pfield[80];
+    snprintf(pfield, sizeof pfield, "params.%s", pname);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"params\":{\"%s\":%.17g}}", pname, phi * 2 + 1) == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "bad_param", pfield));
+    cJSON_Delete(e);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":7,\"camera\":{\"orbit\":{\"azimuth\":1,\"elevation\":2,\"distance\":-1}}}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "bad_field", "camera"));
+    cJSON_Delete(e);
+    SL_CHECK(still_usable(&a, 2));
+
+    /* A valid parameter change is broadcast as a state patch and renders a new frame. */
+    uint32_t before = a.max_frame_id;
+    double newv = pint ? plo : fmin(phi, plo + 0.01);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"params\":{\"%s\":%.17g}}", pname, newv) == 0);
+    cJSON *st = tclient_wait_type(&a, "state", T);
+    const cJSON *pp = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "patch"), "params");
+    SL_CHECK(pp && fabs(cJSON_GetObjectItemCaseSensitive(pp, pname)->valuedouble - newv) < 1e-9);
+    uint32_t set_version = st ? (uint32_t)cJSON_GetObjectItemCaseSensitive(st, "version")->valuedouble : 0;
+    cJSON_Delete(st);
+    SL_CHECK(set_version > 0 && wait_version(&a, set_version) == 0 && a.max_frame_id > before);
+
+    /* --- oversize messages close only that connection --- */
+    tclient big;
+    SL_CHECK(tclient_connect(&big, h.port, NULL) == 0);
+    char *huge = malloc(SL_PROTO_MAX_HELLO + 100);
+    memset(huge, ' ', SL_PROTO_MAX_HELLO + 100);
+    huge[0] = '{';
+    huge[SL_PROTO_MAX_HELLO + 99] = '}';
+    SL_CHECK(sl_wsclient_send_text(big.ws, huge, SL_PROTO_MAX_HELLO + 100, &big.err) == SL_OK);
+    free(huge);
+    cJSON *junk = NULL;
+    int r = tclient_next(&big, T, &junk);
+    cJSON_Delete(junk);
+    SL_CHECK_MSG(r == 0 && big.close_code == 1008, "before hello: r=%d close=%d", r, big.close_code);
+    tclient_close(&big);
+    SL_CHECK(tclient_connect(&big, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&big, NULL, NULL, 32, 32) == 0);
+    size_t hn = SL_PROTO_MAX_MESSAGE + 10;
+    huge = malloc(hn);
+    memset(huge, ' ', hn);
+    huge[0] = '{';
+    huge[hn - 1] = '}';
+    SL_CHECK(sl_wsclient_send_text(big.ws, huge, hn, &big.err) == SL_OK);
+    free(huge);
+    do {
+        junk = NULL;
+        r = tclient_next(&big, T, &junk);
+        cJSON_Delete(junk);
+    } while (r > 0);
+    SL_CHECK_MSG(r == 0 && big.close_code == 1008, "after hello: r=%d close=%d", r, big.close_code);
+    tclient_close(&big);
+    SL_CHECK(still_usable(&a, 3));
+
+    /* --- wrong token refused (error, then close); unknown session too --- */
+    tclient bad;
+    SL_CHECK(tclient_connect(&bad, h.port, NULL) == 0);
+    SL_CHECK(tclient_send(&bad, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\"}", a.session,
+                          "00000000000000000000000000000000") == 0);
+    e = tclient_wait_type(&bad, "error", T);
+    SL_CHECK(error_is(e, "bad_token", "token"));
+    cJSON_Delete(e);
+    r = tclient_next(&bad, T, NULL);
+    SL_CHECK(r == 0 || bad.closed);
+    tclient_close(&bad);
+    SL_CHECK(tclient_connect(&bad, h.port, NULL) == 0);
+    SL_CHECK(tclient_send(&bad, "{\"type\":\"camera\",\"seq\":1,\"camera\":{}}") == 0);
+    e = tclient_wait_type(&bad, "error", T);
+    SL_CHECK(error_is(e, "hello_required", "type"));
+    cJSON_Delete(e);
+    tclient_close(&bad);
+
+    /* --- Origin check --- */
+    tclient o;
+    SL_CHECK(tclient_connect(&o, h.port, "http://evil.example") != 0);
+    char origin[64];
+    snprintf(origin, sizeof origin, "http://127.0.0.1:%d", h.port);
+    SL_CHECK(tclient_connect(&o, h.port, origin) == 0);
+    tclient_close(&o);
+
+    /* --- two clients, one session: same changes, same frame ids; control --- */
+    tclient b;
+    SL_CHECK(tclient_connect(&b, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&b, a.session, a.token, 999, 999) == 0);
+    SL_CHECK(strcmp(cJSON_GetObjectItemCaseSensitive(b.welcome, "role")->valuestring, "viewer") == 0);
+    SL_CHECK(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(b.welcome, "state"), "width")->valueint == W);
+    b.auto_ack = 1;
+    /* The late joiner gets the latest frame at once, without any change. */
+    SL_CHECK(tclient_wait_frame(&b, 0, 0, T) == 0);
+    SL_CHECK(b.last.h.frame_id == a.max_frame_id);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":10,\"camera\":{\"orbit\":{\"azimuth\":200,\"elevation\":10,\"distance\":2.2}}}") == 0);
+    st = tclient_wait_type(&b, "state", T);
+    const cJSON *cs = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "patch"), "camera_seq");
+    SL_CHECK(cs && cs->valueint == 10);
+    cJSON_Delete(st);
+    SL_CHECK(tclient_wait_frame(&a, 10, 1, T) == 0);
+    SL_CHECK(tclient_wait_frame(&b, 10, 1, T) == 0);
+    SL_CHECK_MSG(a.last.h.frame_id == b.last.h.frame_id, "frame ids %u vs %u", a.last.h.frame_id, b.last.h.frame_id);
+    SL_CHECK(a.last.h.payload_bytes == b.last.h.payload_bytes &&
+             memcmp(a.last.payload, b.last.payload, a.last.h.payload_bytes) == 0);
+    /* The viewer is refused until it holds control. */
+    SL_CHECK(tclient_send(&b, "{\"type\":\"camera\",\"seq\":11,\"camera\":{\"orbit\":{\"azimuth\":10,\"elevation\":10,\"distance\":2}}}") == 0);
+    e = tclient_wait_type(&b, "error", T);
+    SL_CHECK(error_is(e, "not_controller", NULL));
+    cJSON_Delete(e);
+    SL_CHECK(tclient_send(&b, "{\"type\":\"control\",\"action\":\"request\"}") == 0);
+    cJSON *req = tclient_wait_type(&a, "control_request", T);
+    SL_CHECK(req && cJSON_GetObjectItemCaseSensitive(req, "client")->valueint == b.client_id);
+    cJSON_Delete(req);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"control\",\"action\":\"grant\",\"client\":%d}", b.client_id) == 0);
+    int granted = 0;
+    for (int i = 0; i < 10 && !granted; i++) {
+        st = tclient_wait_type(&b, "state", T);
+        const cJSON *ctl = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "patch"), "controller");
+        granted = ctl && ctl->valueint == b.client_id;
+        cJSON_Delete(st);
+        if (!st)
+            break;
+    }
+    SL_CHECK(granted);
+    SL_CHECK(tclient_send(&b, "{\"type\":\"camera\",\"seq\":12,\"camera\":{\"orbit\":{\"azimuth\":20,\"elevation\":15,\"distance\":2}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&a, 12, 1, T) == 0);
+    SL_CHECK(tclient_wait_frame(&b, 12, 1, T) == 0);
+    SL_CHECK(a.last.h.frame_id == b.last.h.frame_id);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":13,\"camera\":{\"orbit\":{\"azimuth\":20,\"elevation\":15,\"distance\":2}}}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "not_controller", NULL));
+    cJSON_Delete(e);
+    SL_CHECK(tclient_send(&b, "{\"type\":\"control\",\"action\":\"grant\",\"client\":%d}", a.client_id) == 0);
+    SL_CHECK(still_usable(&b, 4));
+
+    /* --- ack window: a client that never acks gets at most 2 frames; others keep receiving --- */
+    tclient lazy;
+    SL_CHECK(tclient_connect(&lazy, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&lazy, a.session, a.token, W, H) == 0);
+    int a_before = a.frames;
+    for (int i = 0; i < 6; i++) {
+        SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":%d,\"camera\":{\"orbit\":{\"azimuth\":%d,\"elevation\":5,\"distance\":2}}}",
+                              20 + i, 30 * i) == 0);
+        SL_CHECK(tclient_wait_frame(&a, (uint32_t)(20 + i), 1, T) == 0);
+    }
+    /* Drain the lazy client for a while without acking. */
+    double until = harness_now_ms() + 1500;
+    while (harness_now_ms() < until)
+        if (tclient_next(&lazy, 100, NULL) == 0)
+            break;
+    /* The frame at join plus one more fill the window of 2; six more renders send nothing. */
+    SL_CHECK_MSG(lazy.frames == 2, "non-acking client received %d frames", lazy.frames);
+    SL_CHECK_MSG(a.frames - a_before >= 6, "acking client received %d frames", a.frames - a_before);
+    /* Once it acks, it receives the newest frame, not the backlog. */
+    SL_CHECK(tclient_send(&lazy, "{\"type\":\"ack\",\"frame\":%u}", lazy.max_frame_id) == 0);
+    SL_CHECK(tclient_wait_frame(&lazy, 25, 0, T) == 0);
+    SL_CHECK(lazy.last.h.frame_id == a.max_frame_id);
+    tclient_close(&lazy);
+
+    /* --- snapshot: one lossless PNG of the current view; it must match the last
+     *     still JPEG of the same state (same orientation: JPEG rows come from GL's
+     *     bottom-up readback through TurboJPEG's bottom-up flag, PNG from a top-down read) --- */
+    SL_CHECK(a.last.h.kind == SL_FRAME_JPEG && a.last.h.camera_seq == 25 &&
+             !(a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE));
+    sl_image still_jpeg = decode_last(&a);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"snapshot\"}") == 0);
+    int got_png = 0;
+    double sdl = harness_now_ms() + T;
+    while (!got_png && harness_now_ms() < sdl) {
+        if (tclient_next(&a, T, NULL) == 2 && a.last.h.kind == SL_FRAME_PNG)
+            got_png = 1;
+    }
+    SL_CHECK(got_png);
+    if (got_png) {
+        char path[400];
+        snprintf(path, sizeof path, "%s/snap.png", h.dir);
+        FILE *f = fopen(path, "wb");
+        SL_CHECK(f && fwrite(a.last.payload, 1, a.last.h.payload_bytes, f) == a.last.h.payload_bytes);
+        if (f)
+            fclose(f);
+        sl_image png = {0};
+        sl_err err;
+        SL_CHECK(sl_png_read(path, &png, &err) == SL_OK && png.width == W && png.height == H);
+        SL_CHECK(foreground_fraction(&png) > 0.01);
+        double dj = mean_diff(&png, &still_jpeg);
+        SL_CHECK_MSG(dj >= 0 && dj < 4.0, "PNG snapshot vs still JPEG mean abs difference %.3f (bound 4)", dj);
+        /* The same comparison against the JPEG flipped upside down must be clearly worse. */
+        sl_image flipped = {.width = still_jpeg.width, .height = still_jpeg.height,
+                            .rgba = malloc((size_t)still_jpeg.width * (size_t)still_jpeg.height * 4)};
+        if (flipped.rgba && still_jpeg.rgba) {
+            size_t row = (size_t)still_jpeg.width * 4;
+            for (int y = 0; y < still_jpeg.height; y++)
+                memcpy(flipped.rgba + row * (size_t)y, still_jpeg.rgba + row * (size_t)(still_jpeg.height - 1 - y), row);
+            double df = mean_diff(&png, &flipped);
+            SL_CHECK_MSG(df > 2 * dj, "flipped difference %.3f vs %.3f", df, dj);
+        }
+        sl_image_deinit(&flipped);
+        sl_image_deinit(&png);
+    }
+
+    /* --- save / list / load views --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"save_view\",\"name\":\"front\"}") == 0);
+    cJSON *sv = tclient_wait_type(&a, "view_saved", T);
+    SL_CHECK(sv != NULL);
+    cJSON_Delete(sv);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"list_views\"}") == 0);
+    cJSON *vl = tclient_wait_type(&a, "views", T);
+    const cJSON *v0 = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(vl, "views"), 0);
+    SL_CHECK(v0 && strcmp(cJSON_GetObjectItemCaseSensitive(v0, "name")->valuestring, "front") == 0);
+    cJSON_Delete(vl);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":40,\"camera\":{\"orbit\":{\"azimuth\":77,\"elevation\":7,\"distance\":3}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&a, 40, 1, T) == 0);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"load_view\",\"name\":\"front\"}") == 0);
+    int restored = 0;
+    for (int i = 0; i < 10 && !restored; i++) {
+        st = tclient_wait_type(&a, "state", T);
+        const cJSON *cam = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "patch"), "camera");
+        const cJSON *az = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(cam, "orbit"), "azimuth");
+        restored = az && fabs(az->valuedouble - 150.0) < 1e-9; /* the last camera before save: 30*5 */
+        cJSON_Delete(st);
+        if (!st)
+            break;
+    }
+    SL_CHECK(restored);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"load_view\",\"name\":\"nope\"}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "not_found", "name"));
+    cJSON_Delete(e);
+
+    /* --- list_datasets and scene switch --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"list_datasets\"}") == 0);
+    cJSON *dl = tclient_wait_type(&a, "datasets", T);
+    const cJSON *dsj;
+    int has_tiny_bounds = 0;
+    cJSON_ArrayForEach(dsj, cJSON_GetObjectItemCaseSensitive(dl, "datasets")) {
+        if (strcmp(cJSON_GetObjectItemCaseSensitive(dsj, "name")->valuestring, "tiny") == 0)
+            has_tiny_bounds = cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(dsj, "bounds")) == 2;
+    }
+    SL_CHECK(has_tiny_bounds);
+    cJSON_Delete(dl);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"no-such-dataset\"}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "not_found", "dataset"));
+    cJSON_Delete(e);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"no-such-technique\"}") == 0);
+    e = tclient_wait_type(&a, "error", T);
+    SL_CHECK(error_is(e, "not_found", "technique"));
+    cJSON_Delete(e);
+
+    /* --- scene switches: a file dataset added while the server runs, another technique,
+     *     and a dataset whose file vanished (render_failed reaches every client) --- */
+    {
+        char objpath[512], datadir[400];
+        snprintf(datadir, sizeof datadir, "%s/data", h.dir);
+        snprintf(objpath, sizeof objpath, "%s/lines.obj", datadir);
+        FILE *obj = fopen(objpath, "w");
+        SL_CHECK(obj != NULL);
+        if (obj) {
+            fputs("v 0 0 0\nv 1 2 3\nv 0.5 1 0\nv 1 0 3\nl 1 2\nl 3 4\n", obj);
+            fclose(obj);
+        }
+        char *add[] = {h.exe, "catalog", "add", objpath, "--db", h.db, "--data-dir", datadir, NULL};
+        SL_CHECK(harness_run_wait(add) == 0);
+        SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
+        int saw_dataset = 0, saw_bounds = 0;
+        uint32_t version = 0;
+        double deadline = harness_now_ms() + T;
+        while ((!saw_dataset || !saw_bounds) && harness_now_ms() < deadline) {
+            cJSON *m = tclient_wait_type(&a, "state", T);
+            if (!m)
+                break;
+            const cJSON *patch = cJSON_GetObjectItemCaseSensitive(m, "patch");
+            const cJSON *dsn = cJSON_GetObjectItemCaseSensitive(patch, "dataset");
+            const cJSON *bounds = cJSON_GetObjectItemCaseSensitive(patch, "bounds");
+            if (cJSON_IsString(dsn) && strcmp(dsn->valuestring, "lines.obj") == 0) {
+                saw_dataset = 1;
+                version = (uint32_t)cJSON_GetObjectItemCaseSensitive(m, "version")->valuedouble;
+            }
+            if (saw_dataset && cJSON_GetArraySize(bounds) == 2) {
+                const double want[2][3] = {{0, 0, 0}, {1, 2, 3}};
+                int ok = 1;
+                for (int i = 0; i < 2; i++)
+                    for (int k = 0; k < 3; k++)
+                        ok = ok && fabs(cJSON_GetArrayItem(cJSON_GetArrayItem(bounds, i), k)->valuedouble - want[i][k]) < 1e-5;
+                SL_CHECK_MSG(ok, "bounds of lines.obj");
+                saw_bounds = 1;
+            }
+            cJSON_Delete(m);
+        }
+        SL_CHECK(saw_dataset && saw_bounds);
+        SL_CHECK(wait_version(&a, version) == 0);
+
+        /* Another technique that renders line sets, picked from the schema list (never by name). */
+        const char *current = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "state"),
+                                                               "technique")->valuestring;
+        const char *other = NULL;
+        const cJSON *t;
+        cJSON_ArrayForEach(t, cJSON_GetObjectItemCaseSensitive(a.welcome, "techniques")) {
+            const cJSON *k;
+            int lines = 0;
+            cJSON_ArrayForEach(k, cJSON_GetObjectItemCaseSensitive(t, "dataset_kinds"))
+                lines |= cJSON_IsString(k) && strcmp(k->valuestring, "lines") == 0;
+            const char *name = cJSON_GetObjectItemCaseSensitive(t, "name")->valuestring;
+            if (lines && strcmp(name, current) != 0 && !other)
+                other = name;
+        }
+        if (other) {
+            uint32_t before_id = a.max_frame_id;
+            SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"%s\"}", other) == 0);
+            uint32_t vo = wait_patch(&a, "technique", other);
+            SL_CHECK_MSG(vo > 0 && wait_version(&a, vo) == 0 && a.max_frame_id > before_id,
+                         "a frame from technique %s", other);
+            SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"%s\"}", current) == 0);
+        }
+
+        /* The file vanishes; switching away (rendered) and back makes the render thread reload and fail. */
+        SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
+        uint32_t vt = wait_patch(&a, "dataset", "tiny");
+        SL_CHECK(vt > 0 && wait_version(&a, vt) == 0);
+        SL_CHECK(unlink(objpath) == 0);
+        SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
+        e = tclient_wait_type(&a, "error", T);
+        SL_CHECK(error_is(e, "render_failed", NULL));
+        cJSON_Delete(e);
+        e = tclient_wait_type(&b, "error", T);
+        SL_CHECK(error_is(e, "render_failed", NULL));
+        cJSON_Delete(e);
+        SL_CHECK(still_usable(&a, 5));
+        SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
+        vt = wait_patch(&a, "dataset", "tiny");
+        SL_CHECK(vt > 0 && wait_version(&a, vt) == 0);
+    }
+
+    /* --- /healthz and /metrics --- */
+    char body[16384];
+    SL_CHECK(http_get(h.port, "/healthz", body, sizeof body) == 200 && strstr(body, "\"status\":\"ok\""));
+    SL_CHECK(http_get(h.port, "/metrics", body, sizeof body) == 200);
+    SL_CHECK(metric(body, "sightline_frames_rendered_total") >= 5);
+    SL_CHECK(metric(body, "sightline_clients") >= 2);
+    SL_CHECK(metric(body, "sightline_sessions") >= 1);
+    SL_CHECK(strstr(body, "sightline_encode_ms_bucket{le=\"+Inf\"}") != NULL);
+    SL_CHECK(http_get(h.port, "/no-such-file", body, sizeof body) == 404);
+
+    /* --- grace period: rejoin after all clients left, then expiry --- */
+    char sid[64], tok[64];
+    snprintf(sid, sizeof sid, "%s", a.session);
+    snprintf(tok, sizeof tok, "%s", a.token);
+    uint32_t last_id = a.max_frame_id;
+    tclient_close(&a);
+    tclient_close(&b);
+    usleep(300000);
+    tclient re;
+    SL_CHECK(tclient_connect(&re, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&re, sid, tok, W, H) == 0);
+    SL_CHECK(tclient_wait_frame(&re, 0, 0, T) == 0 && re.last.h.frame_id >= last_id);
+    tclient_close(&re);
+    usleep(4500000); /* grace 2 s + sweep period 1 s + margin */
+    SL_CHECK(tclient_connect(&re, h.port, NULL) == 0);
+    SL_CHECK(tclient_send(&re, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\"}", sid, tok) == 0);
+    e = tclient_wait_type(&re, "error", T);
+    SL_CHECK(error_is(e, "unknown_session", "session"));
+    cJSON_Delete(e);
+    tclient_close(&re);
+
+    sl_image_deinit(&still_jpeg);
+    sl_image_deinit(&first);
+    sl_image_deinit(&second);
+    int status = harness_stop(&h);
+    SL_CHECK_MSG(status == 0, "server exit status %d", status);
+    SL_TEST_END();
+}

@@ -1,0 +1,403 @@
+/* test_diff.c — image comparison metrics (renderer/image/diff.c) and the sightline-diff tool.
+ *
+ * Metrics are checked on constructed images whose answers are known in closed
+ * form (one pixel off by 40, a constant offset of 10, hand-placed coverage
+ * holes) and on random images against an independent brute-force reference
+ * in double (bound: 1e-9 relative). The tool is run as a process from
+ * $SIGHTLINE_BINARY_DIR/bin/sightline-diff: exit codes 0/1/2 and its JSON are
+ * checked. Temporary files go to a mkdtemp folder under /tmp. Single-threaded.
+ */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "image/sl_diff.h"
+#include "image/sl_image.h"
+#include "sl_test.h"
+
+static char tmpdir[64];
+
+static const char *tmp_path(const char *name)
+{
+    static char buf[8][256];
+    static int next;
+    char *p = buf[next++ % 8];
+    snprintf(p, 256, "%s/%s", tmpdir, name);
+    return p;
+}
+
+static uint32_t rng = 777u;
+static uint32_t rand_u32(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 17;
+    rng ^= rng << 5;
+    return rng;
+}
+
+static sl_image make_image(int w, int h, uint8_t grey)
+{
+    sl_image img = {w, h, malloc((size_t)w * h * 4)};
+    for (int i = 0; i < w * h; i++) {
+        img.rgba[i * 4 + 0] = img.rgba[i * 4 + 1] = img.rgba[i * 4 + 2] = grey;
+        img.rgba[i * 4 + 3] = 255;
+    }
+    return img;
+}
+
+static sl_depth_image make_depth(int w, int h, float v)
+{
+    sl_depth_image img = {w, h, malloc((size_t)w * h * sizeof(float))};
+    for (int i = 0; i < w * h; i++)
+        img.values[i] = v;
+    return img;
+}
+
+static void test_colour_one_pixel(void)
+{
+    enum { W = 16, H = 8, N = W * H };
+    sl_image a = make_image(W, H, 100), b = make_image(W, H, 100);
+    b.rgba[(3 * W + 5) * 4 + 1] = 140;                 /* G of one pixel +40 */
+    b.rgba[(3 * W + 5) * 4 + 0] = 110;                 /* R +10: the max over RGB is 40 */
+    b.rgba[(0 * W + 0) * 4 + 3] = 0;                   /* alpha is ignored */
+    sl_diff_result r;
+    sl_err err = {0};
+    uint8_t *heat = NULL;
+    SL_CHECK(sl_diff_images(&a, &b, 8.0, &r, &heat, &err) == SL_OK);
+    SL_CHECK(r.width == W && r.height == H);
+    SL_CHECK_NEAR(r.max_abs, 40.0, 0.0);
+    SL_CHECK_NEAR(r.mean_abs, 40.0 / N, 1e-12);
+    SL_CHECK(r.bad_count == 1 && r.compared == N);
+    SL_CHECK_NEAR(r.bad_pct, 100.0 / N, 1e-12);
+    double mse = (40.0 * 40.0 + 10.0 * 10.0) / (3.0 * N);
+    SL_CHECK_NEAR(r.psnr_db, 10.0 * log10(255.0 * 255.0 / mse), 1e-9);
+    SL_CHECK(r.coverage_mismatch == 0);
+
+    /* Heat: equal pixels black (opaque), the one differing pixel white (it is the max). */
+    SL_CHECK(heat != NULL);
+    if (heat) {
+        int black = 1;
+        for (int i = 0; i < N; i++)
+            if (i != 3 * W + 5)
+                black &= heat[i * 4] == 0 && heat[i * 4 + 1] == 0 && heat[i * 4 + 2] == 0 && heat[i * 4 + 3] == 255;
+        SL_CHECK_MSG(black, "equal pixels must be black in the heat map");
+        const uint8_t *p = heat + (3 * W + 5) * 4;
+        SL_CHECK(p[0] == 255 && p[1] == 255 && p[2] == 255);
+    }
+    free(heat);
+
+    /* Threshold equal to the difference: not bad (strictly greater). */
+    SL_CHECK(sl_diff_images(&a, &b, 40.0, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.bad_count == 0 && r.bad_pct == 0.0);
+    SL_CHECK(sl_diff_images(&a, &b, 39.5, &r, NULL, &err) == SL_OK && r.bad_count == 1);
+
+    /* Threshold above the max: the heat map is scaled by the threshold, so the pixel is red, not white. */
+    SL_CHECK(sl_diff_images(&a, &b, 160.0, &r, &heat, &err) == SL_OK);
+    if (heat) {
+        const uint8_t *p = heat + (3 * W + 5) * 4;
+        SL_CHECK_MSG(p[0] > 100 && p[1] < 255 && p[2] == 0, "heat (%d,%d,%d)", p[0], p[1], p[2]);
+    }
+    free(heat);
+    sl_image_deinit(&a);
+    sl_image_deinit(&b);
+}
+
+static void test_colour_identical_and_offset(void)
+{
+    sl_image a = make_image(10, 7, 50), b = make_image(10, 7, 50);
+    sl_diff_result r;
+    sl_err err = {0};
+    SL_CHECK(sl_diff_images(&a, &b, 8.0, &r, NULL, &err) == SL_OK);
+    SL_CHECK(isinf(r.psnr_db) && r.psnr_db > 0);
+    SL_CHECK(r.mean_abs == 0.0 && r.max_abs == 0.0 && r.bad_count == 0);
+
+    for (int i = 0; i < 10 * 7 * 4; i++)
+        if (i % 4 != 3)
+            b.rgba[i] = 60;
+    SL_CHECK(sl_diff_images(&a, &b, 8.0, &r, NULL, &err) == SL_OK);
+    SL_CHECK_NEAR(r.psnr_db, 20.0 * log10(255.0 / 10.0), 1e-9);
+    SL_CHECK_NEAR(r.mean_abs, 10.0, 1e-12);
+    SL_CHECK(r.bad_count == 70);
+    SL_CHECK_NEAR(r.bad_pct, 100.0, 1e-12);
+
+    /* Size mismatch and bad arguments. */
+    sl_image c = make_image(7, 10, 50);
+    uint8_t *heat = (uint8_t *)&r;
+    SL_CHECK(sl_diff_images(&a, &c, 8.0, &r, &heat, &err) == SL_ERR_INVALID);
+    SL_CHECK(heat == NULL);
+    SL_CHECK(strstr(err.message, "10x7") && strstr(err.message, "7x10"));
+    SL_CHECK(sl_diff_images(&a, &b, -1.0, &r, NULL, &err) == SL_ERR_INVALID);
+    SL_CHECK(sl_diff_images(&a, &b, NAN, &r, NULL, &err) == SL_ERR_INVALID);
+    sl_image empty = {0};
+    SL_CHECK(sl_diff_images(&a, &empty, 8.0, &r, NULL, &err) == SL_ERR_INVALID);
+    sl_image_deinit(&a);
+    sl_image_deinit(&b);
+    sl_image_deinit(&c);
+}
+
+/* Independent reference: per-channel differences kept in an array, then reduced. */
+static void test_colour_random_reference(void)
+{
+    enum { W = 31, H = 17, N = W * H };
+    sl_image a = make_image(W, H, 0), b = make_image(W, H, 0);
+    for (int i = 0; i < N * 4; i++) {
+        a.rgba[i] = (uint8_t)rand_u32();
+        b.rgba[i] = (uint8_t)(a.rgba[i] + (int)(rand_u32() % 21) - 10);
+    }
+    static double diffs[N][3];
+    for (int i = 0; i < N; i++)
+        for (int c = 0; c < 3; c++)
+            diffs[i][c] = fabs((double)a.rgba[i * 4 + c] - (double)b.rgba[i * 4 + c]);
+    double mean = 0, max = 0, sse = 0;
+    long bad = 0;
+    for (int i = 0; i < N; i++) {
+        double d = fmax(diffs[i][0], fmax(diffs[i][1], diffs[i][2]));
+        mean += d / N;
+        max = fmax(max, d);
+        bad += d > 5.0;
+        sse += diffs[i][0] * diffs[i][0] + diffs[i][1] * diffs[i][1] + diffs[i][2] * diffs[i][2];
+    }
+    double psnr = 20.0 * log10(255.0) - 10.0 * log10(sse / (3.0 * N));
+    sl_diff_result r;
+    sl_err err = {0};
+    SL_CHECK(sl_diff_images(&a, &b, 5.0, &r, NULL, &err) == SL_OK);
+    SL_CHECK_NEAR(r.mean_abs, mean, 1e-9 * mean);
+    SL_CHECK_NEAR(r.max_abs, max, 0.0);
+    SL_CHECK_NEAR(r.psnr_db, psnr, 1e-9 * psnr);
+    SL_CHECK(r.bad_count == bad);
+    sl_image_deinit(&a);
+    sl_image_deinit(&b);
+}
+
+static void test_depth(void)
+{
+    enum { W = 10, H = 10 };
+    sl_depth_image a = make_depth(W, H, 1.0f), b = make_depth(W, H, 1.0f);
+    const int only_a_miss[5] = {0, 1, 2, 3, 4};        /* hit in b only */
+    const int only_b_miss[3] = {50, 51, 99};           /* hit in a only */
+    for (int i = 0; i < 5; i++)
+        a.values[only_a_miss[i]] = 0.0f;
+    for (int i = 0; i < 3; i++)
+        b.values[only_b_miss[i]] = 0.0f;
+    a.values[60] = b.values[60] = 0.0f;                /* hit in neither */
+    b.values[70] = NAN;                                /* not a hit either */
+    b.values[80] = 1.5f;                               /* compared, differs by 0.5 */
+    b.values[81] = 1.0005f;                            /* differs by ~5e-4, under 1e-3 */
+    a.values[82] = -2.0f;                              /* negative = no hit: mismatch */
+
+    sl_diff_result r;
+    sl_err err = {0};
+    uint8_t *heat = NULL;
+    SL_CHECK(sl_diff_depths(&a, &b, 1e-3, &r, &heat, &err) == SL_OK);
+    long mismatch = 5 + 3 + 1 + 1;                     /* + NaN (70) + negative (82) */
+    long either = 100 - 1;                             /* all but pixel 60 */
+    long compared = either - mismatch;
+    SL_CHECK_MSG(r.coverage_mismatch == mismatch, "mismatch %ld", r.coverage_mismatch);
+    SL_CHECK_NEAR(r.coverage_mismatch_pct, 100.0 * mismatch / either, 1e-12);
+    SL_CHECK(r.compared == compared);
+    double d81 = fabs((double)1.0005f - 1.0);
+    SL_CHECK_NEAR(r.max_abs, 0.5, 0.0);
+    SL_CHECK_NEAR(r.mean_abs, (0.5 + d81) / compared, 1e-15);
+    SL_CHECK(r.bad_count == 1);
+    SL_CHECK_NEAR(r.bad_pct, 100.0 / compared, 1e-12);
+    double mse = (0.25 + d81 * d81) / compared;
+    SL_CHECK_NEAR(r.psnr_db, 10.0 * log10(1.5 * 1.5 / mse), 1e-9);
+    if (heat) {
+        const uint8_t *p = heat + 0 * 4;
+        SL_CHECK(p[0] == 255 && p[1] == 0 && p[2] == 255 && p[3] == 255);   /* magenta */
+        p = heat + 51 * 4;
+        SL_CHECK(p[0] == 255 && p[1] == 0 && p[2] == 255);
+        p = heat + 60 * 4;
+        SL_CHECK(p[0] == 0 && p[1] == 0 && p[2] == 0 && p[3] == 255);       /* neither: black */
+        p = heat + 10 * 4;
+        SL_CHECK(p[0] == 0 && p[1] == 0 && p[2] == 0);                      /* equal: black */
+        p = heat + 80 * 4;
+        SL_CHECK(p[0] == 255 && p[1] == 255 && p[2] == 255);                /* the max: white */
+        p = heat + 81 * 4;
+        SL_CHECK(p[0] > 0 && p[2] == 0);                                    /* small: red */
+    } else {
+        SL_CHECK_MSG(0, "no heat map");
+    }
+    free(heat);
+
+    /* Identical, and nothing hit at all. */
+    SL_CHECK(sl_diff_depths(&a, &a, 1e-3, &r, NULL, &err) == SL_OK);
+    SL_CHECK(isinf(r.psnr_db) && r.max_abs == 0.0 && r.coverage_mismatch == 0);
+    sl_depth_image z1 = make_depth(4, 4, 0.0f), z2 = make_depth(4, 4, 0.0f);
+    SL_CHECK(sl_diff_depths(&z1, &z2, 1e-3, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.compared == 0 && r.coverage_mismatch_pct == 0.0 && r.bad_pct == 0.0 && r.mean_abs == 0.0);
+
+    SL_CHECK(sl_diff_depths(&a, &z1, 1e-3, &r, NULL, &err) == SL_ERR_INVALID);
+    SL_CHECK(strstr(err.message, "sizes differ") != NULL);
+    sl_depth_image_deinit(&z1);
+    sl_depth_image_deinit(&z2);
+    sl_depth_image_deinit(&a);
+    sl_depth_image_deinit(&b);
+}
+
+/* ---- the sightline-diff process ----------------------------------------- */
+
+static char tool[512];
+
+/* Runs the tool with args; returns the exit status (-1 if it did not exit
+ * normally) and the parsed stdout JSON in *json (NULL when not JSON). */
+static int run_tool(const char *args, cJSON **json)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' %s 2>'%s/stderr.txt'", tool, args, tmpdir);
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    static char out[16384];
+    size_t n = fread(out, 1, sizeof out - 1, p);
+    out[n] = '\0';
+    int status = pclose(p);
+    *json = n ? cJSON_Parse(out) : NULL;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static int json_has_failed(const cJSON *json, const char *name)
+{
+    const cJSON *failed = cJSON_GetObjectItemCaseSensitive(json, "failed");
+    const cJSON *it;
+    cJSON_ArrayForEach(it, failed)
+        if (cJSON_IsString(it) && strcmp(it->valuestring, name) == 0)
+            return 1;
+    return 0;
+}
+
+static double json_number(const cJSON *json, const char *name)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(json, name);
+    return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+static void test_tool(void)
+{
+    const char *dir = getenv("SIGHTLINE_BINARY_DIR");
+    SL_CHECK_MSG(dir != NULL, "SIGHTLINE_BINARY_DIR is not set (run through ctest)");
+    if (!dir)
+        return;
+    snprintf(tool, sizeof tool, "%s/bin/sightline-diff", dir);
+
+    sl_err err = {0};
+    sl_image a = make_image(20, 10, 100), b = make_image(20, 10, 100), c = make_image(10, 20, 100);
+    b.rgba[(2 * 20 + 3) * 4] = 140;
+    SL_CHECK(sl_png_write(tmp_path("a.png"), a.rgba, 20, 10, &err) == SL_OK);
+    SL_CHECK(sl_png_write(tmp_path("b.png"), b.rgba, 20, 10, &err) == SL_OK);
+    SL_CHECK(sl_png_write(tmp_path("c.png"), c.rgba, 10, 20, &err) == SL_OK);
+    sl_depth_image da = make_depth(8, 8, 2.0f), db = make_depth(8, 8, 2.0f);
+    db.values[5] = 0.0f;
+    db.values[6] = 2.25f;
+    SL_CHECK(sl_pfm_write(tmp_path("a.pfm"), da.values, 8, 8, &err) == SL_OK);
+    SL_CHECK(sl_pfm_write(tmp_path("b.pfm"), db.values, 8, 8, &err) == SL_OK);
+    FILE *f = fopen(tmp_path("trunc.png"), "wb");
+    if (f) {
+        fwrite("\x89PNG\r\n\x1a\n\0\0", 1, 10, f);
+        fclose(f);
+    }
+
+    char args[1024];
+    cJSON *j = NULL;
+    snprintf(args, sizeof args, "%s/a.png %s/a.png", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    SL_CHECK_MSG(j != NULL, "identical: stdout is not JSON");
+    SL_CHECK(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(j, "psnr_db")));
+    SL_CHECK(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(j, "pass")));
+    const cJSON *kind = cJSON_GetObjectItemCaseSensitive(j, "kind");
+    SL_CHECK(cJSON_IsString(kind) && strcmp(kind->valuestring, "color") == 0);
+    cJSON_Delete(j);
+
+    snprintf(args, sizeof args, "%s/a.png %s/b.png --max-abs 10 --max-mean 1 --diff %s/heat.png",
+             tmpdir, tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK_MSG(j != NULL, "limit exceeded: stdout is not JSON");
+    SL_CHECK(cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(j, "pass")));
+    SL_CHECK(json_has_failed(j, "max_abs") && !json_has_failed(j, "max_mean"));
+    SL_CHECK_NEAR(json_number(j, "max_abs"), 40.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "mean_abs"), 40.0 / 200.0, 1e-12);
+    SL_CHECK_NEAR(json_number(j, "bad_count"), 1.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "compared"), 200.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "bad_threshold"), 8.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "width"), 20.0, 0.0);
+    cJSON_Delete(j);
+    sl_image heat = {0};
+    SL_CHECK_MSG(sl_png_read(tmp_path("heat.png"), &heat, &err) == SL_OK, "%s", err.message);
+    SL_CHECK(heat.width == 20 && heat.height == 10);
+    SL_CHECK(heat.rgba && heat.rgba[(2 * 20 + 3) * 4] == 255 && heat.rgba[0] == 0);
+    sl_image_deinit(&heat);
+
+    snprintf(args, sizeof args, "%s/a.png %s/b.png --max-abs 50 --bad-threshold 50 --max-bad-pct 0", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    SL_CHECK(j && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(j, "pass")));
+    SL_CHECK_NEAR(json_number(j, "bad_threshold"), 50.0, 0.0);
+    cJSON_Delete(j);
+
+    /* Depth: kind by magic bytes (the names end in .pfm, but that is not what counts). */
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 1", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK_MSG(j != NULL, "depth: stdout is not JSON");
+    kind = cJSON_GetObjectItemCaseSensitive(j, "kind");
+    SL_CHECK(cJSON_IsString(kind) && strcmp(kind->valuestring, "depth") == 0);
+    SL_CHECK_NEAR(json_number(j, "coverage_mismatch"), 1.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "coverage_mismatch_pct"), 100.0 / 64.0, 1e-12);
+    SL_CHECK_NEAR(json_number(j, "compared"), 63.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "max_abs"), 0.25, 0.0);
+    SL_CHECK_NEAR(json_number(j, "bad_threshold"), 1e-3, 0.0);
+    SL_CHECK(json_has_failed(j, "max_coverage_pct"));
+    cJSON_Delete(j);
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-abs 0.3", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    cJSON_Delete(j);
+
+    /* Bad input: exit 2, nothing on stdout. */
+    const char *bad[] = {
+        "%s/a.png %s/a.pfm",                /* mixed kinds */
+        "%s/a.png %s/c.png",                /* size mismatch */
+        "%s/a.png %s/missing.png",          /* unreadable */
+        "%s/a.png %s/trunc.png",            /* truncated PNG */
+        "%s/a.png %s/stderr.txt",           /* neither kind */
+        "%s/a.png %s/a.png --max-abs",      /* missing value */
+        "%s/a.png %s/a.png --max-abs x",    /* not a number */
+        "%s/a.png %s/a.png --frobnicate 1", /* unknown option */
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(args, sizeof args, bad[i], tmpdir, tmpdir);
+        int code = run_tool(args, &j);
+        SL_CHECK_MSG(code == 2, "'%s': exit %d, want 2", bad[i], code);
+        SL_CHECK_MSG(j == NULL, "'%s': unexpected JSON on stdout", bad[i]);
+        cJSON_Delete(j);
+    }
+    snprintf(args, sizeof args, "%s/a.png", tmpdir);
+    SL_CHECK(run_tool(args, &j) == 2);
+    cJSON_Delete(j);
+
+    sl_image_deinit(&a);
+    sl_image_deinit(&b);
+    sl_image_deinit(&c);
+    sl_depth_image_deinit(&da);
+    sl_depth_image_deinit(&db);
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/sl_test_diff_XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        fprintf(stderr, "cannot create a temporary folder\n");
+        return 1;
+    }
+    test_colour_one_pixel();
+    test_colour_identical_and_offset();
+    test_colour_random_reference();
+    test_depth();
+    test_tool();
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "warning: could not remove %s\n", tmpdir);
+    SL_TEST_END();
+}

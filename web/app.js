@@ -1,0 +1,305 @@
+// app.js — the Sightline page: connects (protocol.js), draws frames on the
+// canvas with createImageBitmap, acks them, wires camera input (camera.js),
+// schema-generated parameter controls (controls.js), dataset/technique
+// pickers, views, snapshots, sharing, control requests and the status line.
+// The session id and token live in the URL fragment (#session=..&token=..),
+// so a reload or a shared link joins the same session.
+// window.sightline exposes read-only counters for the browser test.
+
+import { Connection } from './protocol.js';
+import { CameraControl } from './camera.js';
+import { ParamControls } from './controls.js';
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view');
+const ctx2d = canvas.getContext('2d');
+
+const frag = new URLSearchParams(location.hash.slice(1));
+const conn = new Connection({
+  session: frag.get('session'),
+  token: frag.get('token'),
+  width: 640,
+  height: 480,
+});
+
+const app = {
+  state: null,
+  techniques: [],
+  datasets: [],
+  clientId: 0,
+  frames: 0,
+  lastFrame: null,
+  frameTimes: [],
+  sentAt: new Map(),   // camera seq -> send time (ms)
+  latencyMs: null,
+  seq: 0,
+  decoding: false,
+  pendingFrame: null,
+};
+window.sightline = {
+  get frames() { return app.frames; },
+  get lastFrame() { return app.lastFrame; },
+  get state() { return app.state; },
+  get clientId() { return app.clientId; },
+  get cameraSeq() { return app.seq; },
+  get stateVersion() { return app.stateVersion; },
+  get connected() { return conn.ws?.readyState === WebSocket.OPEN; },
+};
+
+const camera = new CameraControl(canvas, (phase, cam) => {
+  const seq = ++app.seq;
+  app.sentAt.set(seq, performance.now());
+  if (app.sentAt.size > 256) app.sentAt.delete(app.sentAt.keys().next().value);
+  conn.send({ type: 'camera', seq, phase, camera: cam });
+});
+
+$('params').addEventListener('submit', (e) => e.preventDefault());
+const params = new ParamControls($('params'), (name, value) => {
+  conn.send({ type: 'set', params: { [name]: value } });
+});
+
+function isController() {
+  return app.state && app.state.controller === app.clientId;
+}
+
+function refreshRole() {
+  const ctl = isController();
+  $('role').textContent = ctl ? 'controller' : 'viewer';
+  $('control').hidden = ctl;
+  camera.enabled = ctl;
+  params.setEnabled(ctl);
+  $('dataset').disabled = !ctl;
+  $('technique').disabled = !ctl;
+  $('load-view').disabled = !ctl;
+}
+
+function techniqueByName(name) {
+  return app.techniques.find((t) => t.name === name);
+}
+
+function datasetByName(name) {
+  return app.datasets.find((d) => d.name === name);
+}
+
+function fillPickers() {
+  const dsSel = $('dataset'), tSel = $('technique');
+  dsSel.replaceChildren(...app.datasets.map((d) => {
+    const o = new Option(`${d.name} (${d.kind})`, d.name);
+    o.title = d.description || d.path || '';
+    return o;
+  }));
+  const kind = datasetByName(app.state?.dataset)?.kind;
+  tSel.replaceChildren(...app.techniques
+    .filter((t) => !kind || (t.dataset_kinds || []).includes(kind))
+    .map((t) => { const o = new Option(t.name, t.name); o.title = t.description || ''; return o; }));
+  if (app.state) { dsSel.value = app.state.dataset; tSel.value = app.state.technique; }
+}
+
+function applyState(patch) {
+  const techniqueChanged = patch.technique && patch.technique !== app.state?.technique;
+  const datasetChanged = patch.dataset && patch.dataset !== app.state?.dataset;
+  app.state = { ...(app.state || {}), ...patch };
+  const t = techniqueByName(app.state.technique);
+  if (t && (techniqueChanged || !params.inputs.size)) params.build(t.params || []);
+  params.update(app.state.params);
+  if (techniqueChanged || datasetChanged) fillPickers();
+  // The controller's own camera is authoritative locally; it adopts only
+  // cameras it did not send (scene, load_view) and new bounds.
+  if ('camera' in patch && (!isController() || !('camera_seq' in patch))) camera.adopt(patch.camera, app.state.bounds || null);
+  else if ('bounds' in patch) camera.adopt(null, app.state.bounds || null);
+  refreshRole();
+}
+
+function setBanner(text) {
+  const b = $('banner');
+  b.textContent = text || '';
+  b.hidden = !text;
+}
+
+function updateShareLink() {
+  const url = new URL(location.href);
+  url.hash = `session=${encodeURIComponent(conn.session)}&token=${encodeURIComponent(conn.token)}`;
+  history.replaceState(null, '', url);
+  $('share-link').value = url.toString();
+}
+
+function updateStatus() {
+  const f = app.lastFrame;
+  const now = performance.now();
+  app.frameTimes = app.frameTimes.filter((t) => now - t < 1000);
+  const parts = [`${app.frameTimes.length} fps`];
+  if (app.latencyMs !== null) parts.push(`latency ${app.latencyMs.toFixed(0)} ms`);
+  if (f) {
+    parts.push(`${f.width}×${f.height} ${(f.bytes / 1024).toFixed(1)} KiB`);
+    parts.push(`render ${f.renderMs.toFixed(1)} ms`, `encode ${f.encodeMs.toFixed(1)} ms`);
+    parts.push(f.interactive ? 'interactive' : 'still');
+    parts.push(`frame ${f.frameId}`);
+  }
+  $('status').textContent = parts.join(' · ');
+}
+setInterval(updateStatus, 500);
+
+// Draws the newest frame; frames arriving during a decode replace each other (newest wins).
+async function drawFrame(header, payload) {
+  if (app.decoding) { app.pendingFrame = { header, payload }; return; }
+  app.decoding = true;
+  try {
+    const bitmap = await createImageBitmap(new Blob([payload], { type: 'image/jpeg' }));
+    if (app.state) {
+      if (canvas.width !== app.state.width || canvas.height !== app.state.height) {
+        canvas.width = app.state.width;
+        canvas.height = app.state.height;
+      }
+    }
+    ctx2d.imageSmoothingEnabled = true;
+    ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
+    bitmap.close();
+    app.frames++;
+    app.frameTimes.push(performance.now());
+    app.lastFrame = { ...header, bytes: payload.byteLength };
+    const sent = app.sentAt.get(header.cameraSeq);
+    if (sent !== undefined) {
+      app.latencyMs = performance.now() - sent;
+      app.sentAt.delete(header.cameraSeq);
+    }
+    updateStatus();
+  } catch (e) {
+    console.warn('frame decode failed', e);
+  } finally {
+    app.decoding = false;
+    conn.send({ type: 'ack', frame: header.frameId });
+    if (app.pendingFrame) {
+      const next = app.pendingFrame;
+      app.pendingFrame = null;
+      drawFrame(next.header, next.payload);
+    }
+  }
+}
+
+function downloadSnapshot(payload) {
+  const url = URL.createObjectURL(new Blob([payload], { type: 'image/png' }));
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = `sightline-${app.state?.dataset || 'view'}-${Date.now()}.png`;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
+conn.addEventListener('message', (ev) => {
+  const msg = ev.detail;
+  switch (msg.type) {
+    case 'welcome':
+      app.clientId = msg.client;
+      app.techniques = msg.techniques || [];
+      app.datasets = msg.datasets || [];
+      app.state = null;
+      params.schemaKey = '';
+      applyState(msg.state);
+      app.stateVersion = msg.state.version;
+      fillPickers();
+      camera.adopt(msg.state.camera, msg.state.bounds || null);
+      updateShareLink();
+      setBanner('');
+      conn.send({ type: 'list_views' });
+      break;
+    case 'state':
+      applyState(msg.patch || {});
+      app.stateVersion = msg.version;
+      break;
+    case 'datasets':
+      app.datasets = msg.datasets || [];
+      fillPickers();
+      break;
+    case 'views':
+      $('views').replaceChildren(...(msg.views || []).map((v) => new Option(`${v.name} — ${v.dataset}/${v.technique}`, v.name)));
+      break;
+    case 'view_saved':
+      conn.send({ type: 'list_views' });
+      break;
+    case 'control_request': {
+      $('requests').hidden = false;
+      const b = document.createElement('button');
+      b.type = 'button';
+      b.textContent = `Grant control to client ${msg.client}`;
+      b.addEventListener('click', () => {
+        conn.send({ type: 'control', action: 'grant', client: msg.client });
+        b.remove();
+        if (!$('request-list').children.length) $('requests').hidden = true;
+      });
+      $('request-list').append(b);
+      break;
+    }
+    case 'error':
+      setBanner(`${msg.code}: ${msg.message}${msg.field ? ` (${msg.field})` : ''}`);
+      setTimeout(() => { if ($('banner').textContent.startsWith(msg.code)) setBanner(''); }, 4000);
+      break;
+    default:
+      break;
+  }
+});
+
+conn.addEventListener('frame', (ev) => {
+  const { header, payload } = ev.detail;
+  if (header.kind === 'png') downloadSnapshot(payload);
+  else drawFrame(header, payload);
+});
+
+conn.addEventListener('disconnect', () => {
+  setBanner('Disconnected from the server — reconnecting to the same session…');
+});
+
+$('dataset').addEventListener('change', (e) => {
+  const kind = datasetByName(e.target.value)?.kind;
+  const current = techniqueByName(app.state?.technique);
+  const msg = { type: 'scene', dataset: e.target.value };
+  if (current && kind && !(current.dataset_kinds || []).includes(kind)) {
+    const t = app.techniques.find((x) => (x.dataset_kinds || []).includes(kind));
+    if (t) msg.technique = t.name;
+  }
+  conn.send(msg);
+});
+$('technique').addEventListener('change', (e) => conn.send({ type: 'scene', technique: e.target.value }));
+$('control').addEventListener('click', () => conn.send({ type: 'control', action: 'request' }));
+$('snapshot').addEventListener('click', () => conn.send({ type: 'snapshot' }));
+$('save-view').addEventListener('click', () => {
+  const name = $('view-name').value.trim();
+  if (name) conn.send({ type: 'save_view', name });
+});
+$('load-view').addEventListener('click', () => {
+  const name = $('views').value;
+  if (name) conn.send({ type: 'load_view', name });
+});
+$('share').addEventListener('click', async () => {
+  updateShareLink();
+  const link = $('share-link').value;
+  try {
+    await navigator.clipboard.writeText(link);
+    setBanner('Share link copied');
+  } catch {
+    $('share-link').select();
+    setBanner('Copy the share link from the field');
+  }
+  setTimeout(() => setBanner(''), 2000);
+});
+
+// Keep the session's image size matched to the stage (controller only), debounced.
+let resizeTimer = null;
+new ResizeObserver(() => {
+  clearTimeout(resizeTimer);
+  resizeTimer = setTimeout(() => {
+    if (!isController()) return;
+    const stage = $('stage');
+    const w = Math.max(64, Math.min(1920, Math.round(stage.clientWidth)));
+    const h = Math.max(48, Math.min(1080, Math.round(stage.clientHeight)));
+    if (app.state && (w !== app.state.width || h !== app.state.height)) conn.send({ type: 'resize', width: w, height: h });
+  }, 250);
+}).observe($('stage'));
+
+{
+  const stage = $('stage');
+  conn.width = Math.max(64, Math.min(1920, Math.round(stage.clientWidth || 640)));
+  conn.height = Math.max(48, Math.min(1080, Math.round(stage.clientHeight || 480)));
+}
+conn.open();

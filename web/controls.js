@@ -1,0 +1,118 @@
+// controls.js — parameter controls generated from a technique's schema
+// (sl_params_schema_json: name, type, min, max, default, choices, unit,
+// description). float/int -> slider + value with unit, bool -> checkbox,
+// enum -> select (colormaps too), vec3 -> three number fields. Descriptions
+// become tooltips. Knows nothing about techniques by name.
+
+function fmt(v, type) {
+  if (type === 'int') return String(Math.round(v));
+  const s = Number(v).toPrecision(4);
+  // Trim zeros after a decimal point only ("0.2500" -> "0.25", "1000" stays, "1.000e+9" stays).
+  return s.includes('.') && !s.includes('e') ? s.replace(/0+$/, '').replace(/\.$/, '') : s;
+}
+
+// Slider position <-> value; wide ranges (max/min > 1000, min >= 0) are logarithmic.
+function scaleFor(def) {
+  const lo = def.min, hi = def.max;
+  if (def.type === 'float' && lo >= 0 && hi > 1000 * Math.max(lo, 1e-6)) {
+    const l0 = Math.log10(Math.max(lo, 1e-4)), l1 = Math.log10(hi);
+    return {
+      toSlider: (v) => (v <= 0 ? 0 : (Math.log10(Math.max(v, 1e-4)) - l0) / (l1 - l0)),
+      fromSlider: (s) => (s <= 0 ? lo : 10 ** (l0 + s * (l1 - l0))),
+      step: 'any', min: 0, max: 1,
+    };
+  }
+  return {
+    toSlider: (v) => v, fromSlider: (s) => Number(s),
+    step: def.type === 'int' ? 1 : (hi - lo) / 200, min: lo, max: hi,
+  };
+}
+
+export class ParamControls {
+  // onChange(name, value) is called when the user changes a control.
+  constructor(form, onChange) {
+    this.form = form;
+    this.onChange = onChange;
+    this.inputs = new Map();   // name -> { def, set(value) }
+    this.schemaKey = '';
+  }
+
+  build(schema) {
+    const key = JSON.stringify(schema.map((d) => d.name));
+    if (key === this.schemaKey) return;
+    this.schemaKey = key;
+    this.form.replaceChildren();
+    this.inputs.clear();
+    for (const def of schema) {
+      const row = document.createElement('label');
+      row.className = 'param';
+      row.title = def.description || '';
+      const name = document.createElement('span');
+      name.className = 'name';
+      name.textContent = def.name;
+      row.append(name);
+      let entry;
+      if (def.type === 'float' || def.type === 'int') {
+        const sc = scaleFor(def);
+        const slider = document.createElement('input');
+        slider.type = 'range';
+        slider.name = def.name;
+        slider.min = sc.min; slider.max = sc.max; slider.step = sc.step;
+        const out = document.createElement('output');
+        const unit = def.unit ? ` ${def.unit}` : '';
+        slider.addEventListener('input', () => { out.textContent = fmt(sc.fromSlider(slider.value), def.type) + unit; });
+        slider.addEventListener('change', () => {
+          let v = sc.fromSlider(slider.value);
+          if (def.type === 'int') v = Math.round(v);
+          this.onChange(def.name, v);
+        });
+        row.append(slider, out);
+        entry = { def, set: (v) => { slider.value = sc.toSlider(v); out.textContent = fmt(v, def.type) + unit; } };
+      } else if (def.type === 'bool') {
+        const box = document.createElement('input');
+        box.type = 'checkbox';
+        box.name = def.name;
+        box.addEventListener('change', () => this.onChange(def.name, box.checked));
+        row.append(box);
+        entry = { def, set: (v) => { box.checked = !!v; } };
+      } else if (def.type === 'enum') {
+        const sel = document.createElement('select');
+        sel.name = def.name;
+        for (const c of def.choices || []) sel.append(new Option(c, c));
+        sel.addEventListener('change', () => this.onChange(def.name, sel.value));
+        row.append(sel);
+        entry = { def, set: (v) => { sel.value = v; } };
+      } else if (def.type === 'vec3') {
+        const fields = [0, 1, 2].map(() => {
+          const f = document.createElement('input');
+          f.type = 'number';
+          f.step = 'any';
+          f.min = def.min; f.max = def.max;
+          f.className = 'vec';
+          return f;
+        });
+        for (const f of fields) {
+          f.addEventListener('change', () => this.onChange(def.name, fields.map((x) => Number(x.value))));
+          row.append(f);
+        }
+        entry = { def, set: (v) => { fields.forEach((f, i) => { f.value = Array.isArray(v) ? v[i] : 0; }); } };
+      } else {
+        continue;
+      }
+      this.inputs.set(def.name, entry);
+      this.form.append(row);
+    }
+  }
+
+  // Shows the session's values (after a welcome or a state patch).
+  update(values) {
+    for (const [name, v] of Object.entries(values || {})) {
+      const e = this.inputs.get(name);
+      if (e && document.activeElement?.name !== name) e.set(v);
+    }
+  }
+
+  setEnabled(on) {
+    for (const el of this.form.querySelectorAll('input, select')) el.disabled = !on;
+  }
+}
