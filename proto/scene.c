@@ -142,7 +142,7 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
     if (!ds)
         return sl_err_set(err, SL_ERR_INVALID, "dataset is required (a catalog name, a file path or {\"generator\": ...})");
     if (!(cJSON_IsString(ds) && ds->valuestring[0]) && !cJSON_IsObject(ds))
-        return sl_err_set(err, SL_ERR_INVALID, "dataset must be a name, a path or a generator object");
+        return sl_err_set(err, SL_ERR_INVALID, "dataset must be a name, a path, a generator object or inline Hermite data {\"nodes\": ..., \"segments\": ...}");
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "technique");
     if (t) {
         if (!cJSON_IsString(t) || strlen(t->valuestring) >= sizeof s->technique)
@@ -285,6 +285,8 @@ sl_status sl_scene_open_dataset(const sl_scene *s, const char *data_dir, sl_data
 {
     *out = NULL;
     if (cJSON_IsObject(s->dataset)) {
+        if (sl_hermite_json_detect(s->dataset))
+            return sl_hermite_dataset_from_json(s->dataset, "inline", out, err);
         char *text = cJSON_PrintUnformatted(s->dataset);
         if (!text)
             return sl_err_set(err, SL_ERR_NOMEM, "out of memory");

@@ -25,9 +25,20 @@ void sl_err_prefix(sl_err *err, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(prefix, sizeof prefix, fmt, ap);
     va_end(ap);
-    char old[SL_ERR_MSG_MAX];
-    memcpy(old, err->message, sizeof old);
-    snprintf(err->message, sizeof err->message, "%s: %s", prefix, old);
+    /* Shift the old message right and write "prefix: " in front of it,
+     * truncating the tail when the two do not fit together. The prefix
+     * (< 256 bytes) always fits in the message (1024 bytes). */
+    _Static_assert(sizeof prefix + 2 < SL_ERR_MSG_MAX, "prefix must fit");
+    size_t cap = sizeof err->message;
+    size_t plen = strlen(prefix);
+    size_t head = plen + 2;
+    size_t tail = strnlen(err->message, cap - 1);
+    if (head + tail > cap - 1)
+        tail = cap - 1 - head;
+    memmove(err->message + head, err->message, tail);
+    err->message[head + tail] = '\0';
+    memcpy(err->message, prefix, plen);
+    memcpy(err->message + plen, ": ", 2);
 }
 
 void sl_err_clear(sl_err *err)

@@ -12,6 +12,7 @@
  */
 #include "load_common.h"
 
+#include <cjson/cJSON.h>
 #include <ctype.h>
 #include <errno.h>
 #include <limits.h>
@@ -214,6 +215,15 @@ sl_status sl_read_file(const char *path, uint64_t limit, uint8_t **data, size_t 
     return SL_OK;
 }
 
+/* A .json dataset is either explicit Hermite line data or a raw volume's sidecar. */
+static sl_status load_json_dataset(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err)
+{
+    cJSON *root = cJSON_ParseWithLength((const char *)data, size);
+    int hermite = sl_hermite_json_detect(root);
+    cJSON_Delete(root);
+    return hermite ? sl_load_hermite_json(data, size, path, out, err) : sl_load_raw_json(data, size, path, out, err);
+}
+
 typedef struct loader_entry {
     const char *ext;
     sl_loader_fn fn;
@@ -222,7 +232,7 @@ typedef struct loader_entry {
 static const loader_entry loaders[] = {
     {".trk", sl_load_trk},   {".tck", sl_load_tck},   {".vtk", sl_load_vtk},
     {".obj", sl_load_obj},   {".nrrd", sl_load_nrrd}, {".nhdr", sl_load_nrrd},
-    {".nii", sl_load_nifti}, {".json", sl_load_raw_json},
+    {".nii", sl_load_nifti}, {".json", load_json_dataset},
 };
 
 #define SL_SUPPORTED_EXTENSIONS ".trk .tck .vtk .obj .nrrd .nhdr .nii .nii.gz .json (each may also be gzipped as NAME.EXT.gz)"

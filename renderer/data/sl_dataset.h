@@ -84,6 +84,13 @@ void sl_dataset_destroy(sl_dataset *ds); /* NULL is fine */
 sl_status sl_lines_alloc(sl_lines *lines, size_t line_count, size_t vertex_count,
                          int with_radii, int with_tangents, sl_err *err);
 
+/* Per-vertex attribute names that carry explicit derivatives (Hermite data,
+ * see sl_load_hermite_json): the derivative of attribute NAME along the line
+ * parameter is NAME + SL_ATTR_DERIVATIVE_SUFFIX. */
+#define SL_ATTR_SCALAR "scalar"
+#define SL_ATTR_DERIVATIVE_SUFFIX "_derivative"
+#define SL_ATTR_RADIUS_DERIVATIVE "radius_derivative"
+
 /* Adds a zero-filled per-vertex (per_line = 0) or per-line attribute and
  * returns its values array, or NULL (err filled) past SL_MAX_ATTRIBUTES. */
 float *sl_lines_add_attribute(sl_lines *lines, const char *name, int per_line, sl_err *err);

@@ -30,6 +30,14 @@ sl_status sl_load_trk(const uint8_t *data, size_t size, const char *path, sl_dat
 sl_status sl_load_tck(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err);
 sl_status sl_load_vtk(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* POLYDATA LINES or STRUCTURED_POINTS */
 sl_status sl_load_obj(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err);
+/* Explicit Hermite line data (JSON with "nodes" and "segments", see load_hermite.c):
+ * one two-vertex line per segment with radii, tangents and the attributes
+ * "scalar", "scalar_derivative", "radius_derivative". Errors name the JSON
+ * path ("nodes[3].t[1] ..."). The cJSON form serves inline scene datasets. */
+struct cJSON;
+sl_status sl_load_hermite_json(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err);
+sl_status sl_hermite_dataset_from_json(const struct cJSON *root, const char *name, sl_dataset **out, sl_err *err);
+int sl_hermite_json_detect(const struct cJSON *root); /* has "nodes" and "segments" */
 /* Volumes */
 sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* .nrrd and .nhdr */
 sl_status sl_load_nifti(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* .nii (gunzipped by the caller for .nii.gz) */

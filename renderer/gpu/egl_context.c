@@ -11,7 +11,6 @@
 #include "sl_gpu.h"
 
 #include <epoxy/egl.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,10 +22,12 @@ struct sl_gpu {
     int software;
 };
 
-/* eglTerminate is per display, and a display is shared by the process: only
- * the last sl_gpu to go terminates it. */
-static pthread_mutex_t display_lock = PTHREAD_MUTEX_INITIALIZER;
-static int display_users;
+/* An EGL display is shared by the whole process and eglInitialize on an
+ * initialized display is a no-op, so sl_gpu never calls eglTerminate: the
+ * display (and the driver it loaded) stays for the process lifetime. This
+ * keeps a later sl_gpu_create from paying for the driver load again, and
+ * avoids unloading Mesa, whose unload leaves allocations that no leak
+ * checker can attribute (the module is gone). Contexts are destroyed. */
 
 static int has_extension(const char *list, const char *name)
 {
@@ -126,12 +127,8 @@ sl_status sl_gpu_create(const sl_gpu_desc *desc, sl_gpu **out, sl_err *err)
         sl_err_set(err, SL_ERR_GPU, "no EGL display: neither a GPU device (EGL_EXT_platform_device) nor Mesa surfaceless is available; install libegl-mesa0 and libgl1-mesa-dri");
         goto fail;
     }
-    pthread_mutex_lock(&display_lock);
     EGLint major = 0, minor = 0;
     EGLBoolean ok = eglInitialize(gpu->display, &major, &minor);
-    if (ok)
-        display_users++;
-    pthread_mutex_unlock(&display_lock);
     if (!ok) {
         sl_err_set(err, SL_ERR_GPU, "eglInitialize failed (0x%x)", (unsigned)eglGetError());
         gpu->display = EGL_NO_DISPLAY;
@@ -198,10 +195,6 @@ void sl_gpu_destroy(sl_gpu *gpu)
         eglMakeCurrent(gpu->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         if (gpu->context != EGL_NO_CONTEXT)
             eglDestroyContext(gpu->display, gpu->context);
-        pthread_mutex_lock(&display_lock);
-        if (display_users > 0 && --display_users == 0)
-            eglTerminate(gpu->display);
-        pthread_mutex_unlock(&display_lock);
         eglReleaseThread();
     }
     free(gpu);

@@ -1,4 +1,4 @@
-/* tubes_nodes.h — Hermite nodes and segments for the `tubes` technique, and explicit Hermite data.
+/* tubes_nodes.h — Hermite nodes and segments for the `tubes` technique.
  *
  * A node carries position, radius and colour scalar, each with its derivative
  * with respect to the segment parameter t in [0, 1]; a segment is an index
@@ -6,7 +6,7 @@
  * Nodes are built from any line set: one node per vertex, one segment per
  * consecutive vertex pair, tangents from the data when it gives them, else
  * Catmull-Rom finite differences (one-sided at line ends). Explicit Hermite
- * data ({"nodes":[...],"segments":[...]}) becomes a line set of two-vertex
+ * data ({"nodes":[...],"segments":[...]}, read by data/load_hermite.c) becomes a line set of two-vertex
  * lines that carries its tangents and derivatives exactly, so it flows
  * through every loader-facing path and the node builder gives the nodes back.
  * Does not touch GL; any thread. Positions stay relative to the dataset origin.
@@ -17,21 +17,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include <cjson/cJSON.h>
-
 #include "../data/sl_dataset.h"
-
-/* Per-vertex attribute names that carry explicit derivatives. The colour
- * derivative of attribute NAME is looked up as NAME + SL_TUBES_DERIVATIVE_SUFFIX. */
-#define SL_TUBES_RADIUS_DERIVATIVE "radius_derivative"
-#define SL_TUBES_DERIVATIVE_SUFFIX "_derivative"
-#define SL_TUBES_SCALAR "scalar"
 
 /* Floats per node in the geometry array: p.xyz, r, t.xyz, dr. */
 #define SL_TUBES_NODE_FLOATS 8
 
 typedef enum sl_tubes_tangents {
-    /* Explicit Hermite data (it has SL_TUBES_RADIUS_DERIVATIVE): its tangents
+    /* Explicit Hermite data (it has SL_ATTR_RADIUS_DERIVATIVE): its tangents
      * exactly. Other data with tangents (e.g. a streamline's velocity, a
      * derivative in time, not along the segment): their direction, with the
      * length of the Catmull-Rom tangent. No tangents: Catmull-Rom. */
@@ -60,18 +52,5 @@ sl_status sl_tubes_nodes_build(const sl_lines *lines, sl_tubes_tangents tangents
 void sl_tubes_nodes_set_color(const sl_lines *lines, int color_attribute, sl_tubes_nodes *out);
 
 void sl_tubes_nodes_deinit(sl_tubes_nodes *nodes); /* zeroed or NULL is fine */
-
-/* Explicit Hermite data: {"nodes":[{"p":[x,y,z],"t":[x,y,z],"r":r,"dr":dr,"c":s,"dc":ds},...],
- * "segments":[[i,j],...]} — p, t and r required; dr, c, dc default 0; r >= 0.
- * Gives a line set with one two-vertex line per segment, radii, tangents and
- * the attributes "scalar", "scalar_derivative", "radius_derivative". Every
- * error names the JSON path ("nodes[3].t[1] ..."). */
-sl_status sl_tubes_dataset_from_json(const cJSON *root, const char *name, sl_dataset **out, sl_err *err);
-
-/* The same from a byte buffer (an sl_loader_fn, see data/sl_load.h). */
-sl_status sl_tubes_load_json(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err);
-
-/* 1 when a JSON document looks like explicit Hermite data (has "nodes" and "segments"). */
-int sl_tubes_json_is_hermite(const cJSON *root);
 
 #endif

@@ -1,4 +1,4 @@
-/* fuzz_tubes_json.c — fuzz target for explicit Hermite tube data (sl_tubes_load_json,
+/* fuzz_tubes_json.c — fuzz target for explicit Hermite tube data (sl_load_hermite_json,
  * renderer/tubes/tubes_nodes.c).
  *
  * Arbitrary bytes as a JSON document, path NULL. On failure *out must stay
@@ -11,13 +11,14 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "data/sl_load.h"
 #include "tubes/tubes_nodes.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     sl_dataset *ds = NULL;
     sl_err err = {0};
-    sl_status st = sl_tubes_load_json(data, size, NULL, &ds, &err);
+    sl_status st = sl_load_hermite_json(data, size, NULL, &ds, &err);
     if (st != SL_OK) {
         if (ds || err.message[0] == '\0')
             abort();

@@ -24,11 +24,8 @@ set_target_properties(test_tubes_reference PROPERTIES RUNTIME_OUTPUT_DIRECTORY $
 add_test(NAME unit.test_tubes_reference COMMAND test_tubes_reference WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(unit.test_tubes_reference PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
 
-# llvmpipe leaks ~112 bytes from a module it unloads, which no suppression can
-# name; leak checking of the tubes code is done by the unit tests.
 function(tubes_render_test name)
   sl_add_render_test(NAME tubes.${name} COMMAND ${ARGN})
-  set_property(TEST render.tubes.${name} APPEND PROPERTY ENVIRONMENT "ASAN_OPTIONS=detect_leaks=0:abort_on_error=0")
 endfunction()
 
 # Random segment sets (chains, bifurcations, varying radius and tangents).

@@ -6,12 +6,8 @@ add_executable(voxel-check ${VOXEL_DIR}/voxel_check.c)
 target_link_libraries(voxel-check PRIVATE sightline_proto sightline_renderer)
 set_target_properties(voxel-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
 
-# The GL driver (llvmpipe) leaks ~112 bytes from a module it unloads, which no
-# suppression can name; leak checking of this code is done by the unit tests
-# (tests/unit/test_voxel_*.c), so the GPU checks run without it.
 function(voxel_render_test name)
   sl_add_render_test(NAME ${name} COMMAND ${ARGN})
-  set_property(TEST render.${name} APPEND PROPERTY ENVIRONMENT "ASAN_OPTIONS=detect_leaks=0:abort_on_error=0")
 endfunction()
 
 # Opaque depth vs tubes_mesh (24 sides, no caps), tornado 150 lines, radius 0.4 %

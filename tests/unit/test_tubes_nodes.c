@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "sl_test.h"
+#include "data/sl_load.h"
 #include "tubes/tubes_nodes.h"
 
 static sl_dataset *three_points(int with_tangents)
@@ -95,7 +96,7 @@ static void test_json(void)
                       "{\"p\":[100002,1,0],\"t\":[0,1,0],\"r\":0.125},"
                       "{\"p\":[100001,0,0],\"t\":[0,-3,0],\"r\":0.25}],"
                       "\"segments\":[[0,1],[1,2],[3,2],[1,0]]}";
-    SL_CHECK(sl_tubes_load_json((const uint8_t *)doc, strlen(doc), "x/h.json", &ds, &err) == SL_OK);
+    SL_CHECK(sl_load_hermite_json((const uint8_t *)doc, strlen(doc), "x/h.json", &ds, &err) == SL_OK);
     if (!ds)
         return;
     SL_CHECK(strcmp(ds->name, "h.json") == 0);
@@ -104,7 +105,7 @@ static void test_json(void)
     SL_CHECK_NEAR(ds->origin.x + ds->lines.positions[3], 100001.0, 1e-6);
     SL_CHECK_NEAR(ds->bounds_max.x, 100002.125, 1e-6);
     sl_tubes_nodes n;
-    int scalar = sl_lines_find_attribute(&ds->lines, SL_TUBES_SCALAR);
+    int scalar = sl_lines_find_attribute(&ds->lines, SL_ATTR_SCALAR);
     SL_CHECK(scalar >= 0);
     SL_CHECK(sl_tubes_nodes_build(&ds->lines, SL_TUBES_TANGENTS_AUTO, scalar, &n, &err) == SL_OK);
     SL_CHECK(n.segment_count == 4);
@@ -141,13 +142,13 @@ static void test_json(void)
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         ds = (sl_dataset *)1;
         err.message[0] = 0;
-        sl_status st = sl_tubes_load_json((const uint8_t *)bad[k][0], strlen(bad[k][0]), NULL, &ds, &err);
+        sl_status st = sl_load_hermite_json((const uint8_t *)bad[k][0], strlen(bad[k][0]), NULL, &ds, &err);
         SL_CHECK_MSG(st != SL_OK && ds == NULL && strstr(err.message, bad[k][1]),
                      "case %zu: status %d message '%s'", k, (int)st, err.message);
     }
     /* an empty but well-formed set is fine: nothing to draw */
     const char *empty = "{\"nodes\":[],\"segments\":[]}";
-    SL_CHECK(sl_tubes_load_json((const uint8_t *)empty, strlen(empty), NULL, &ds, &err) == SL_OK);
+    SL_CHECK(sl_load_hermite_json((const uint8_t *)empty, strlen(empty), NULL, &ds, &err) == SL_OK);
     SL_CHECK(ds && ds->lines.line_count == 0);
     sl_dataset_destroy(ds);
 }

@@ -5,7 +5,7 @@
  *          [--tol 1e-3] [--max-mismatch-pct 0.5] [--ref-samples N] [--data-dir DIR]
  *          [--random-segments N --seed S]
  * Loads the scene's dataset (explicit Hermite JSON, inline or as a .json file,
- * is read by sl_tubes_dataset_from_json; everything else as sightline-render
+ * is read by sl_hermite_dataset_from_json; everything else as sightline-render
  * does), renders the GPU distance map (or reads --gpu-depth, e.g. from
  * `sightline-render --depth`), computes the double-precision reference
  * (tubes_reference.c) and checks: on pixels both hit, |error| <= tol x the
@@ -23,6 +23,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <cjson/cJSON.h>
 
 #include "core/sl_line_style.h"
 #include "data/sl_load.h"
@@ -111,8 +113,8 @@ static cJSON *random_hermite(int n, unsigned long long seed)
 /* Explicit Hermite data inline ({"nodes":..}) or in a .json file; else the scene's own loader. */
 static sl_status open_dataset(const sl_scene *scene, const char *data_dir, sl_dataset **out, sl_err *err)
 {
-    if (sl_tubes_json_is_hermite(scene->dataset))
-        return sl_tubes_dataset_from_json(scene->dataset, "inline", out, err);
+    if (sl_hermite_json_detect(scene->dataset))
+        return sl_hermite_dataset_from_json(scene->dataset, "inline", out, err);
     if (cJSON_IsString(scene->dataset)) {
         const char *name = scene->dataset->valuestring;
         size_t n = strlen(name);
@@ -128,10 +130,10 @@ static sl_status open_dataset(const sl_scene *scene, const char *data_dir, sl_da
             if (st != SL_OK)
                 return st;
             cJSON *root = cJSON_ParseWithLength((const char *)data, size);
-            int hermite = sl_tubes_json_is_hermite(root);
+            int hermite = sl_hermite_json_detect(root);
             cJSON_Delete(root);
             if (hermite)
-                st = sl_tubes_load_json(data, size, path, out, err);
+                st = sl_load_hermite_json(data, size, path, out, err);
             free(data);
             if (hermite)
                 return st;
