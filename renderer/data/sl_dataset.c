@@ -208,6 +208,56 @@ double sl_volume_value(const sl_volume *vol, size_t x, size_t y, size_t z, int c
     return 0.0;
 }
 
+/* Range of the finite values of a scalar volume: one tight loop per voxel type. */
+#define SCALAR_RANGE_LOOP(T)                                 \
+    do {                                                     \
+        const T *p = data;                                   \
+        for (size_t i = 0; i < n; i++) {                     \
+            double s = (double)p[i];                         \
+            if (s < l) l = s;                                \
+            if (s > h) h = s;                                \
+        }                                                    \
+    } while (0)
+
+static void scalar_range(sl_voxel_type type, const void *data, size_t n, double *lo, double *hi)
+{
+    double l = *lo, h = *hi;
+    switch (type) {
+    case SL_VOXEL_U8: SCALAR_RANGE_LOOP(uint8_t); break;
+    case SL_VOXEL_U16: SCALAR_RANGE_LOOP(uint16_t); break;
+    case SL_VOXEL_S16: SCALAR_RANGE_LOOP(int16_t); break;
+    case SL_VOXEL_F32: {
+        const float *p = data;
+        for (size_t i = 0; i < n; i++) {
+            double s = (double)p[i];
+            if (!isfinite(s))
+                continue;
+            if (s < l) l = s;
+            if (s > h) h = s;
+        }
+        break;
+    }
+    }
+    *lo = l;
+    *hi = h;
+}
+#undef SCALAR_RANGE_LOOP
+
+/* Range of the finite magnitudes of a 3-component f32 vector field. */
+static void vector_magnitude_range(const float *f, size_t n, double *lo, double *hi)
+{
+    double l = *lo, h = *hi;
+    for (size_t i = 0; i < n; i++, f += 3) {
+        double s = sqrt((double)f[0] * f[0] + (double)f[1] * f[1] + (double)f[2] * f[2]);
+        if (!isfinite(s))
+            continue;
+        if (s < l) l = s;
+        if (s > h) h = s;
+    }
+    *lo = l;
+    *hi = h;
+}
+
 sl_status sl_dataset_finish_volume(sl_dataset *ds, sl_err *err)
 {
     sl_volume *v = &ds->volume;
@@ -216,23 +266,12 @@ sl_status sl_dataset_finish_volume(sl_dataset *ds, sl_err *err)
             return sl_err_set(err, SL_ERR_FORMAT, "volume spacing %d is %g, must be finite and > 0", c, v->spacing[c]);
     if (!sl_v3_is_finite(ds->origin))
         return sl_err_set(err, SL_ERR_FORMAT, "volume origin is not finite");
-    double lo = DBL_MAX, hi = -DBL_MAX;
     size_t n = (size_t)v->dims[0] * (size_t)v->dims[1] * (size_t)v->dims[2];
-    for (size_t i = 0; i < n; i++) {
-        double s;
-        if (v->components == 3) {
-            const float *f = (const float *)v->data + 3 * i;
-            s = sqrt((double)f[0] * f[0] + (double)f[1] * f[1] + (double)f[2] * f[2]);
-        } else {
-            size_t x = i % (size_t)v->dims[0], y = (i / (size_t)v->dims[0]) % (size_t)v->dims[1];
-            size_t z = i / ((size_t)v->dims[0] * (size_t)v->dims[1]);
-            s = sl_volume_value(v, x, y, z, 0);
-        }
-        if (isfinite(s)) {
-            if (s < lo) lo = s;
-            if (s > hi) hi = s;
-        }
-    }
+    double lo = DBL_MAX, hi = -DBL_MAX;
+    if (v->components == 3)
+        vector_magnitude_range((const float *)v->data, n, &lo, &hi);
+    else
+        scalar_range(v->type, v->data, n, &lo, &hi);
     v->value_min = lo <= hi ? lo : 0.0;
     v->value_max = lo <= hi ? hi : 0.0;
     ds->bounds_min = ds->origin;
