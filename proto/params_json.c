@@ -20,12 +20,19 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
         if (!cJSON_IsBool(item))
             return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be true or false", name);
         return sl_params_set_numbers(p, name, &(double){cJSON_IsTrue(item) ? 1.0 : 0.0}, 1, err);
-    case SL_PARAM_ENUM:
+    case SL_PARAM_ENUM: {
         if (cJSON_IsString(item))
             return sl_params_set_choice(p, name, item->valuestring, err);
         if (cJSON_IsNumber(item))
             return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
-        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a choice name", name);
+        char list[400] = "";
+        for (int k = 0; d->choices[k]; k++) {
+            if (k)
+                strncat(list, ", ", sizeof list - strlen(list) - 1);
+            strncat(list, d->choices[k], sizeof list - strlen(list) - 1);
+        }
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a choice name (choices: %s)", name, list);
+    }
     case SL_PARAM_VEC3: {
         double v[3];
         if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3)

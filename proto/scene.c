@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
@@ -88,6 +89,8 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
     if (o) {
         if (cJSON_GetObjectItemCaseSensitive(obj, "eye") || cJSON_GetObjectItemCaseSensitive(obj, "target"))
             return sl_err_set(err, SL_ERR_INVALID, "camera: give either orbit or eye/target, not both");
+        if (cJSON_GetObjectItemCaseSensitive(obj, "up"))
+            return sl_err_set(err, SL_ERR_INVALID, "camera.up: an orbit camera's up is always +y (use eye/target/up for another)");
         if (!cJSON_IsObject(o))
             return sl_err_set(err, SL_ERR_INVALID, "camera.orbit must be an object");
         if ((st = check_keys(o, "camera.orbit", orbit_keys, err)) != SL_OK)
@@ -237,7 +240,8 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
         return sl_err_set(err, SL_ERR_INVALID, "--set key is too long");
     memcpy(key, assignment, key_len);
     key[key_len] = '\0';
-    cJSON *value = cJSON_Parse(eq + 1);
+    /* JSON only when the whole value is JSON ("2024_run.vtk" stays a string). */
+    cJSON *value = cJSON_ParseWithOpts(eq + 1, NULL, 1);
     if (!value)
         value = cJSON_CreateString(eq + 1);
     if (!value)
@@ -303,6 +307,19 @@ sl_status sl_scene_open_dataset(const sl_scene *s, const char *data_dir, sl_data
         snprintf(path, sizeof path, "%s/%s", data_dir, name);
     else
         snprintf(path, sizeof path, "%s", name);
+    if (!strchr(name, '/') && !strchr(name, '.') && access(path, F_OK) != 0) {
+        /* No path, no extension, no such file: most likely a mistyped name. */
+        int n;
+        const sl_builtin_dataset *list = sl_builtin_datasets(&n);
+        char names[512] = "";
+        for (int i = 0; i < n; i++) {
+            strncat(names, list[i].name, sizeof names - strlen(names) - 1);
+            if (i + 1 < n)
+                strncat(names, ", ", sizeof names - strlen(names) - 1);
+        }
+        return sl_err_set(err, SL_ERR_INVALID, "dataset '%.128s' is neither a built-in dataset (%s) nor a file", name,
+                          names);
+    }
     return sl_load_file(path, out, err);
 }
 

@@ -58,8 +58,10 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes %d number%s, got %d",
                           name, sl_param_type_name(d->type), want, want == 1 ? "" : "s", n);
     for (int k = 0; k < n; k++) {
-        if (!isfinite(v[k]))
-            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a finite number", name);
+        /* Non-finite bools and enum indices fail their own checks below, which name their range. */
+        if (!isfinite(v[k]) && d->type != SL_PARAM_BOOL && d->type != SL_PARAM_ENUM)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a finite number in [%g, %g]%s%s, got %g",
+                              name, d->min, d->max, d->unit[0] ? " " : "", d->unit, v[k]);
         switch (d->type) {
         case SL_PARAM_BOOL:
             if (v[k] != 0.0 && v[k] != 1.0)
@@ -73,7 +75,8 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
         }
         case SL_PARAM_INT:
             if (v[k] != floor(v[k]))
-                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer, got %g", name, v[k]);
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer in [%g, %g], got %g",
+                                  name, d->min, d->max, v[k]);
             /* fall through */
         case SL_PARAM_FLOAT:
         case SL_PARAM_VEC3:

@@ -1,0 +1,546 @@
+/* test_params.c — parameter schemas and their validation (core/sl_params.h, proto/sl_params_json.h).
+ *
+ * For every registered technique and every parameter: the schema is sane
+ * (unique names, min <= max, a unit and a description), the default lies in
+ * range and re-validates, a valid non-default value (given as JSON) is
+ * applied and sl_params_compare reports exactly the declared invalidation
+ * level, both ends of the range are accepted, values just outside, NaN and
+ * +-Inf, wrong JSON types, non-integers and unknown names are rejected with
+ * a message that names the parameter and the allowed range (or choices),
+ * and a failed patch changes nothing. The schema JSON is checked field by
+ * field against the C tables. A private schema covers every type and every
+ * invalidation level, and the typed getters. No GL.
+ */
+#include <cjson/cJSON.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/sl_params.h"
+#include "core/sl_technique.h"
+#include "sl_params_json.h"
+#include "sl_test.h"
+
+static int choice_count(const sl_param_def *d)
+{
+    int n = 0;
+    while (d->choices && d->choices[n])
+        n++;
+    return n;
+}
+
+static int is_numeric(const sl_param_def *d)
+{
+    return d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3;
+}
+
+static int same_values(const sl_params *a, const sl_params *b)
+{
+    return a->count == b->count && memcmp(a->value, b->value, sizeof a->value) == 0;
+}
+
+/* Does the message name the parameter and its allowed range (or its choices)? */
+static int names_range(const char *msg, const sl_param_def *d)
+{
+    char name[80];
+    snprintf(name, sizeof name, "'%s'", d->name);
+    if (!strstr(msg, name))
+        return 0;
+    char range[96];
+    switch (d->type) {
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_INT:
+    case SL_PARAM_VEC3:
+        snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
+        return strstr(msg, range) != NULL;
+    case SL_PARAM_BOOL:
+        return strstr(msg, "true") && strstr(msg, "false");
+    case SL_PARAM_ENUM: {
+        /* Either every choice by name or the index range. */
+        int all = 1;
+        for (int k = 0; d->choices[k]; k++)
+            all &= strstr(msg, d->choices[k]) != NULL;
+        snprintf(range, sizeof range, "[0, %d]", choice_count(d) - 1);
+        return all || strstr(msg, range) != NULL;
+    }
+    }
+    return 0;
+}
+
+/* Applies {name: item} (item is consumed); returns the status, err filled. */
+static sl_status apply_one(sl_params *p, const char *name, cJSON *item, sl_err *err)
+{
+    cJSON *patch = cJSON_CreateObject();
+    cJSON_AddItemToObject(patch, name, item);
+    sl_status st = sl_params_apply_json(p, patch, err);
+    cJSON_Delete(patch);
+    return st;
+}
+
+/* Expects the patch to be refused with the parameter and range named, and nothing changed. */
+static void expect_refused(const sl_params *base, const sl_param_def *d, cJSON *item, const char *what)
+{
+    sl_params p = *base;
+    sl_err err = {0};
+    char *text = cJSON_PrintUnformatted(item);
+    sl_status st = apply_one(&p, d->name, item, &err);
+    SL_CHECK_MSG(st == SL_ERR_INVALID, "%s = %s (%s) was accepted", d->name, text ? text : "?", what);
+    SL_CHECK_MSG(names_range(err.message, d), "%s = %s (%s): message '%s' does not name the parameter and range",
+                 d->name, text ? text : "?", what, err.message);
+    SL_CHECK_MSG(same_values(&p, base), "%s = %s (%s): a refused patch changed values", d->name, text ? text : "?", what);
+    cJSON_free(text);
+}
+
+static void expect_refused_numbers(const sl_params *base, const sl_param_def *d, double x, const char *what)
+{
+    sl_params p = *base;
+    sl_err err = {0};
+    double v[3] = {0, 0, 0};
+    int idx = sl_params_find(base, d->name);
+    int n = d->type == SL_PARAM_VEC3 ? 3 : 1;
+    memcpy(v, base->value[idx], sizeof v);
+    v[n - 1] = x;                               /* the last component is the bad one */
+    sl_status st = sl_params_set_numbers(&p, d->name, v, n, &err);
+    SL_CHECK_MSG(st == SL_ERR_INVALID, "%s = %g (%s) was accepted", d->name, x, what);
+    SL_CHECK_MSG(names_range(err.message, d), "%s = %g (%s): message '%s' does not name the parameter and range",
+                 d->name, x, what, err.message);
+    SL_CHECK_MSG(same_values(&p, base), "%s = %g (%s): a refused set changed values", d->name, x, what);
+    /* The same through JSON (cJSON holds NaN and Inf in memory even though JSON text cannot). */
+    cJSON *item;
+    if (d->type == SL_PARAM_VEC3)
+        item = cJSON_CreateDoubleArray(v, 3);
+    else
+        item = cJSON_CreateNumber(x);
+    if (d->type == SL_PARAM_BOOL) {
+        cJSON_Delete(item);
+        return;                                 /* bools take true/false in JSON, checked elsewhere */
+    }
+    expect_refused(base, d, item, what);
+}
+
+/* A valid value different from the default, as JSON; NULL when there is none. */
+static cJSON *other_value(const sl_param_def *d, double out[3])
+{
+    memcpy(out, d->def, 3 * sizeof(double));
+    switch (d->type) {
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_VEC3:
+        if (d->min == d->max)
+            return NULL;
+        out[0] = d->def[0] < d->max ? d->def[0] + 0.5 * (d->max - d->def[0]) : 0.5 * (d->min + d->def[0]);
+        return d->type == SL_PARAM_FLOAT ? cJSON_CreateNumber(out[0]) : cJSON_CreateDoubleArray(out, 3);
+    case SL_PARAM_INT:
+        if (d->min == d->max)
+            return NULL;
+        out[0] = d->def[0] < d->max ? d->def[0] + 1 : d->def[0] - 1;
+        return cJSON_CreateNumber(out[0]);
+    case SL_PARAM_BOOL:
+        out[0] = d->def[0] != 0.0 ? 0.0 : 1.0;
+        return cJSON_CreateBool(out[0] != 0.0);
+    case SL_PARAM_ENUM: {
+        int n = choice_count(d);
+        if (n < 2)
+            return NULL;
+        out[0] = ((int)d->def[0] + 1) % n;
+        return cJSON_CreateString(d->choices[(int)out[0]]);
+    }
+    }
+    return NULL;
+}
+
+static const char *invalidation_name(sl_invalidation l)
+{
+    static const char *const names[] = {"none", "frame", "prepared", "dataset"};
+    return l >= SL_INVALIDATE_NONE && l <= SL_INVALIDATE_DATASET ? names[l] : "?";
+}
+
+/* Checks one schema entry's JSON description against the C table. */
+static void check_schema_json(const cJSON *o, const sl_param_def *d, const char *tech)
+{
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(o, "name");
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(o, "type");
+    const cJSON *def = cJSON_GetObjectItemCaseSensitive(o, "default");
+    const cJSON *inv = cJSON_GetObjectItemCaseSensitive(o, "invalidates");
+    const cJSON *unit = cJSON_GetObjectItemCaseSensitive(o, "unit");
+    SL_CHECK_MSG(cJSON_IsString(name) && strcmp(name->valuestring, d->name) == 0, "%s: schema JSON name", tech);
+    SL_CHECK_MSG(cJSON_IsString(type) && strcmp(type->valuestring, sl_param_type_name(d->type)) == 0,
+                 "%s.%s: schema JSON type", tech, d->name);
+    SL_CHECK_MSG(cJSON_IsString(inv) && strcmp(inv->valuestring, invalidation_name(d->invalidates)) == 0,
+                 "%s.%s: schema JSON invalidates '%s', declared '%s'", tech, d->name,
+                 cJSON_IsString(inv) ? inv->valuestring : "?", invalidation_name(d->invalidates));
+    SL_CHECK_MSG(cJSON_IsString(unit) && strcmp(unit->valuestring, d->unit) == 0, "%s.%s: unit", tech, d->name);
+    if (is_numeric(d)) {
+        const cJSON *mn = cJSON_GetObjectItemCaseSensitive(o, "min"), *mx = cJSON_GetObjectItemCaseSensitive(o, "max");
+        SL_CHECK_MSG(cJSON_IsNumber(mn) && cJSON_IsNumber(mx) && mn->valuedouble == d->min && mx->valuedouble == d->max,
+                     "%s.%s: schema JSON range", tech, d->name);
+    }
+    int def_ok = 0;
+    switch (d->type) {
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_INT: def_ok = cJSON_IsNumber(def) && def->valuedouble == d->def[0]; break;
+    case SL_PARAM_BOOL: def_ok = cJSON_IsBool(def) && cJSON_IsTrue(def) == (d->def[0] != 0.0); break;
+    case SL_PARAM_ENUM: {
+        def_ok = cJSON_IsString(def) && strcmp(def->valuestring, d->choices[(int)d->def[0]]) == 0;
+        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(o, "choices");
+        int n = choice_count(d), same = cJSON_IsArray(ch) && cJSON_GetArraySize(ch) == n;
+        for (int k = 0; same && k < n; k++) {
+            const cJSON *c = cJSON_GetArrayItem(ch, k);
+            same = cJSON_IsString(c) && strcmp(c->valuestring, d->choices[k]) == 0;
+        }
+        SL_CHECK_MSG(same, "%s.%s: schema JSON choices", tech, d->name);
+        break;
+    }
+    case SL_PARAM_VEC3:
+        def_ok = cJSON_IsArray(def) && cJSON_GetArraySize(def) == 3;
+        for (int k = 0; def_ok && k < 3; k++)
+            def_ok = cJSON_GetArrayItem(def, k)->valuedouble == d->def[k];
+        break;
+    }
+    SL_CHECK_MSG(def_ok, "%s.%s: schema JSON default", tech, d->name);
+}
+
+static void test_parameter(const sl_technique *t, int i)
+{
+    const sl_param_def *d = &t->params[i];
+    sl_params base;
+    sl_params_init(&base, t->params, t->param_count);
+    sl_err err = {0};
+
+    /* Schema sanity and the default in range. */
+    SL_CHECK_MSG(d->name && d->name[0] && d->unit && d->description && d->description[0],
+                 "%s[%d]: name, unit and description are required", t->name, i);
+    SL_CHECK_MSG(d->invalidates >= SL_INVALIDATE_NONE && d->invalidates <= SL_INVALIDATE_DATASET, "%s.%s", t->name, d->name);
+    SL_CHECK(memcmp(base.value[i], d->def, sizeof base.value[i]) == 0);
+    int in_range = 1;
+    switch (d->type) {
+    case SL_PARAM_VEC3:
+        for (int k = 0; k < 3; k++)
+            in_range &= d->def[k] >= d->min && d->def[k] <= d->max;
+        in_range &= isfinite(d->min) && isfinite(d->max) && d->min <= d->max;
+        break;
+    case SL_PARAM_INT:
+        in_range &= d->def[0] == floor(d->def[0]);
+        /* fall through */
+    case SL_PARAM_FLOAT:
+        in_range &= isfinite(d->min) && isfinite(d->max) && d->min <= d->max;
+        in_range &= d->def[0] >= d->min && d->def[0] <= d->max;
+        break;
+    case SL_PARAM_BOOL:
+        in_range &= d->def[0] == 0.0 || d->def[0] == 1.0;
+        break;
+    case SL_PARAM_ENUM:
+        in_range &= choice_count(d) >= 1 && d->def[0] == floor(d->def[0]) && d->def[0] >= 0 &&
+                    d->def[0] < choice_count(d);
+        break;
+    }
+    SL_CHECK_MSG(in_range, "%s.%s: default out of its own range", t->name, d->name);
+    sl_params p = base;
+    SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, d->def, d->type == SL_PARAM_VEC3 ? 3 : 1, &err) == SL_OK,
+                 "%s.%s: the default does not validate: %s", t->name, d->name, err.message);
+
+    /* A valid other value: applied, reported at the declared level. */
+    double want[3];
+    cJSON *item = other_value(d, want);
+    if (item) {
+        p = base;
+        char *text = cJSON_PrintUnformatted(item);
+        sl_status st = apply_one(&p, d->name, item, &err);
+        SL_CHECK_MSG(st == SL_OK, "%s.%s = %s: %s", t->name, d->name, text ? text : "?", err.message);
+        SL_CHECK_MSG(memcmp(p.value[i], want, sizeof want) == 0, "%s.%s = %s not stored", t->name, d->name, text ? text : "?");
+        cJSON_free(text);
+        for (int k = 0; k < base.count; k++)
+            if (k != i)
+                SL_CHECK_MSG(memcmp(p.value[k], base.value[k], sizeof p.value[k]) == 0, "%s: setting %s changed %s",
+                             t->name, d->name, base.schema[k].name);
+        SL_CHECK_MSG(sl_params_compare(&base, &p) == d->invalidates, "%s.%s: compare gives %d, declared %d", t->name,
+                     d->name, (int)sl_params_compare(&base, &p), (int)d->invalidates);
+        SL_CHECK(sl_params_compare(&p, &base) == d->invalidates);
+        /* sl_params_to_json reports the new value, and re-applying it is a no-op. */
+        cJSON *all = sl_params_to_json(&p);
+        sl_params q = base;
+        SL_CHECK(all && sl_params_apply_json(&q, all, &err) == SL_OK && same_values(&q, &p));
+        cJSON_Delete(all);
+    }
+
+    /* Both ends of the range are valid; just outside is not. */
+    if (is_numeric(d)) {
+        const double ends[2] = {d->min, d->max};
+        for (int e = 0; e < 2; e++) {
+            p = base;
+            double v[3] = {ends[e], ends[e], ends[e]};
+            SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, v, d->type == SL_PARAM_VEC3 ? 3 : 1, &err) == SL_OK,
+                         "%s.%s = %g (an end of its range): %s", t->name, d->name, ends[e], err.message);
+        }
+        double step = d->type == SL_PARAM_INT ? 1.0 : 0.0;
+        double below = step ? d->min - 1 : nextafter(d->min, -INFINITY);
+        double above = step ? d->max + 1 : nextafter(d->max, INFINITY);
+        expect_refused_numbers(&base, d, below, "below min");
+        expect_refused_numbers(&base, d, above, "above max");
+        expect_refused_numbers(&base, d, d->min - 1e6 * (1 + fabs(d->min)), "far below min");
+    }
+    if (d->type == SL_PARAM_INT && d->min < d->max)
+        expect_refused_numbers(&base, d, d->min + 0.5, "not an integer");
+    if (d->type == SL_PARAM_ENUM) {
+        expect_refused_numbers(&base, d, (double)choice_count(d), "index past the choices");
+        expect_refused_numbers(&base, d, -1.0, "negative index");
+        expect_refused_numbers(&base, d, 0.5, "fractional index");
+    }
+    if (d->type == SL_PARAM_BOOL) {
+        expect_refused_numbers(&base, d, 0.5, "bool 0.5");
+        expect_refused_numbers(&base, d, 2.0, "bool 2");
+    }
+
+    /* NaN and infinities, for every type. */
+    expect_refused_numbers(&base, d, NAN, "NaN");
+    expect_refused_numbers(&base, d, INFINITY, "+Inf");
+    expect_refused_numbers(&base, d, -INFINITY, "-Inf");
+
+    /* Wrong JSON types. */
+    expect_refused(&base, d, cJSON_CreateNull(), "null");
+    expect_refused(&base, d, cJSON_CreateObject(), "an object");
+    switch (d->type) {
+    case SL_PARAM_FLOAT:
+    case SL_PARAM_INT:
+        expect_refused(&base, d, cJSON_CreateString("1"), "a string");
+        expect_refused(&base, d, cJSON_CreateTrue(), "a bool");
+        expect_refused(&base, d, cJSON_CreateDoubleArray(d->def, 1), "an array");
+        break;
+    case SL_PARAM_BOOL:
+        expect_refused(&base, d, cJSON_CreateNumber(1), "a number");
+        expect_refused(&base, d, cJSON_CreateString("true"), "a string");
+        break;
+    case SL_PARAM_ENUM:
+        expect_refused(&base, d, cJSON_CreateString("no_such_choice"), "an unknown choice");
+        expect_refused(&base, d, cJSON_CreateString(""), "an empty choice");
+        expect_refused(&base, d, cJSON_CreateTrue(), "a bool");
+        expect_refused(&base, d, cJSON_CreateStringArray(d->choices, 1), "an array");
+        break;
+    case SL_PARAM_VEC3: {
+        expect_refused(&base, d, cJSON_CreateNumber(d->def[0]), "a number");
+        expect_refused(&base, d, cJSON_CreateDoubleArray(d->def, 2), "two numbers");
+        double four[4] = {d->def[0], d->def[1], d->def[2], d->def[0]};
+        expect_refused(&base, d, cJSON_CreateDoubleArray(four, 4), "four numbers");
+        cJSON *mixed = cJSON_CreateDoubleArray(d->def, 2);
+        cJSON_AddItemToArray(mixed, cJSON_CreateString("0"));
+        expect_refused(&base, d, mixed, "a string component");
+        break;
+    }
+    }
+
+    /* All-or-nothing: a valid change followed by a bad one changes nothing. */
+    item = other_value(d, want);
+    if (item) {
+        p = base;
+        cJSON *patch = cJSON_CreateObject();
+        cJSON_AddItemToObject(patch, d->name, item);
+        cJSON_AddNumberToObject(patch, "no_such_parameter", 1);
+        SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_ERR_INVALID);
+        SL_CHECK_MSG(same_values(&p, &base), "%s.%s: a failed patch applied its valid part", t->name, d->name);
+        cJSON_Delete(patch);
+    }
+}
+
+static void test_techniques(void)
+{
+    int n = 0;
+    const sl_technique *const *list = sl_technique_list(&n);
+    SL_CHECK(list != NULL && n >= 1);
+    for (int ti = 0; ti < n; ti++) {
+        const sl_technique *t = list[ti];
+        SL_CHECK_MSG(t && t->name && t->name[0] && t->description && t->description[0], "technique %d", ti);
+        SL_CHECK(sl_technique_find(t->name) == t);
+        SL_CHECK_MSG(t->param_count >= 0 && t->param_count <= SL_PARAMS_MAX, "%s: %d params", t->name, t->param_count);
+        SL_CHECK(t->prepare && t->render && t->release);
+        for (int tj = 0; tj < ti; tj++)
+            SL_CHECK_MSG(strcmp(list[tj]->name, t->name) != 0, "technique name '%s' is registered twice", t->name);
+        for (int i = 0; i < t->param_count; i++)
+            for (int j = 0; j < i; j++)
+                SL_CHECK_MSG(strcmp(t->params[i].name, t->params[j].name) != 0, "%s: parameter '%s' twice", t->name,
+                             t->params[i].name);
+
+        for (int i = 0; i < t->param_count; i++)
+            test_parameter(t, i);
+
+        /* Defaults as JSON re-apply as a no-op. */
+        sl_params base, p;
+        sl_params_init(&base, t->params, t->param_count);
+        p = base;
+        sl_err err = {0};
+        cJSON *defaults = sl_params_to_json(&base);
+        SL_CHECK(cJSON_GetArraySize(defaults) == t->param_count);
+        SL_CHECK(sl_params_apply_json(&p, defaults, &err) == SL_OK && same_values(&p, &base));
+        SL_CHECK(sl_params_compare(&p, &base) == SL_INVALIDATE_NONE);
+        cJSON_Delete(defaults);
+        /* NULL, JSON null and {} are empty patches; a non-object is an error. */
+        SL_CHECK(sl_params_apply_json(&p, NULL, &err) == SL_OK);
+        cJSON *x = cJSON_CreateNull();
+        SL_CHECK(sl_params_apply_json(&p, x, &err) == SL_OK);
+        cJSON_Delete(x);
+        x = cJSON_CreateArray();
+        SL_CHECK(sl_params_apply_json(&p, x, &err) == SL_ERR_INVALID);
+        SL_CHECK(strstr(err.message, "object") != NULL);
+        cJSON_Delete(x);
+        SL_CHECK(same_values(&p, &base));
+
+        /* Unknown names: the name is quoted and every known name listed. */
+        x = cJSON_CreateObject();
+        cJSON_AddNumberToObject(x, "no_such_parameter", 1);
+        SL_CHECK(sl_params_apply_json(&p, x, &err) == SL_ERR_INVALID);
+        cJSON_Delete(x);
+        SL_CHECK_MSG(strstr(err.message, "'no_such_parameter'") != NULL, "%s", err.message);
+        for (int i = 0; i < t->param_count; i++)
+            SL_CHECK_MSG(strstr(err.message, t->params[i].name) != NULL, "%s: unknown-name message lacks '%s': %s",
+                         t->name, t->params[i].name, err.message);
+        SL_CHECK(sl_params_set_numbers(&p, "Radius", (double[]){1}, 1, &err) == SL_ERR_INVALID); /* case matters */
+        SL_CHECK(sl_params_set_choice(&p, "no_such_parameter", "x", &err) == SL_ERR_INVALID);
+        SL_CHECK(strstr(err.message, "'no_such_parameter'") != NULL);
+        SL_CHECK(sl_params_find(&p, "no_such_parameter") == -1);
+        SL_CHECK(same_values(&p, &base));
+
+        /* The schema as JSON. */
+        cJSON *tj = sl_technique_json(t);
+        const cJSON *params = cJSON_GetObjectItemCaseSensitive(tj, "params");
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(tj, "name");
+        const cJSON *kinds = cJSON_GetObjectItemCaseSensitive(tj, "dataset_kinds");
+        SL_CHECK(cJSON_IsString(name) && strcmp(name->valuestring, t->name) == 0);
+        SL_CHECK(cJSON_IsArray(kinds) && cJSON_GetArraySize(kinds) >= 1);
+        SL_CHECK_MSG(cJSON_IsArray(params) && cJSON_GetArraySize(params) == t->param_count, "%s: schema JSON size", t->name);
+        for (int i = 0; i < t->param_count && i < cJSON_GetArraySize(params); i++)
+            check_schema_json(cJSON_GetArrayItem(params, i), &t->params[i], t->name);
+        cJSON_Delete(tj);
+    }
+    SL_CHECK(sl_technique_find("no_such_technique") == NULL);
+    SL_CHECK(sl_technique_find("") == NULL);
+}
+
+/* A private schema: every type and every invalidation level. */
+static const char *const fruit[] = {"apple", "banana", "cherry", NULL};
+static const sl_param_def test_schema[] = {
+    {"f", SL_PARAM_FLOAT, -2.5, 10.0, {1.5}, NULL, "world", "a float", SL_INVALIDATE_NONE},
+    {"i", SL_PARAM_INT, -3, 7, {2}, NULL, "", "an int", SL_INVALIDATE_FRAME},
+    {"b", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "a bool", SL_INVALIDATE_PREPARED},
+    {"e", SL_PARAM_ENUM, 0, 0, {1}, fruit, "", "an enum", SL_INVALIDATE_DATASET},
+    {"v", SL_PARAM_VEC3, -1, 1, {0.1, 0.2, 0.3}, NULL, "rgb", "a vec3", SL_INVALIDATE_FRAME},
+};
+enum { TEST_COUNT = (int)(sizeof test_schema / sizeof test_schema[0]) };
+static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL};
+
+static void test_private_schema(void)
+{
+    for (int i = 0; i < TEST_COUNT; i++)
+        test_parameter(&test_tech, i);
+
+    sl_params p, base;
+    sl_params_init(&p, test_schema, TEST_COUNT);
+    base = p;
+    SL_CHECK(p.count == TEST_COUNT && p.schema == test_schema);
+    SL_CHECK(sl_params_float(&p, "f") == 1.5);
+    SL_CHECK(sl_params_int(&p, "i") == 2);
+    SL_CHECK(sl_params_bool(&p, "b") == true);
+    SL_CHECK(sl_params_choice(&p, "e") == 1);
+    SL_CHECK(strcmp(sl_params_choice_name(&p, "e"), "banana") == 0);
+    float v[3];
+    sl_params_vec3(&p, "v", v);
+    SL_CHECK(v[0] == 0.1f && v[1] == 0.2f && v[2] == 0.3f);
+
+    sl_err err = {0};
+    cJSON *patch = cJSON_Parse("{\"f\": -2.5, \"i\": 7, \"b\": false, \"e\": \"cherry\", \"v\": [-1, 0, 1]}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK);
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_float(&p, "f") == -2.5);
+    SL_CHECK(sl_params_int(&p, "i") == 7);
+    SL_CHECK(sl_params_bool(&p, "b") == false);
+    SL_CHECK(sl_params_choice(&p, "e") == 2 && strcmp(sl_params_choice_name(&p, "e"), "cherry") == 0);
+    sl_params_vec3(&p, "v", v);
+    SL_CHECK(v[0] == -1.0f && v[1] == 0.0f && v[2] == 1.0f);
+    /* Everything changed: the largest level wins. */
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_DATASET);
+    /* An enum by index too. */
+    patch = cJSON_Parse("{\"e\": 0}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && sl_params_choice(&p, "e") == 0);
+    cJSON_Delete(patch);
+    /* set_choice on a non-enum names the parameter. */
+    SL_CHECK(sl_params_set_choice(&p, "f", "apple", &err) == SL_ERR_INVALID && strstr(err.message, "'f'"));
+    /* A wrong count of numbers. */
+    SL_CHECK(sl_params_set_numbers(&p, "v", (double[]){0.5}, 1, &err) == SL_ERR_INVALID && strstr(err.message, "'v'"));
+    SL_CHECK(sl_params_set_numbers(&p, "f", (double[]){1, 2, 3}, 3, &err) == SL_ERR_INVALID && strstr(err.message, "'f'"));
+
+    /* Levels combine by maximum; only differing values count. */
+    sl_params a = base, b = base;
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_NONE);
+    SL_CHECK(sl_params_set_numbers(&b, "f", (double[]){3}, 1, &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_NONE);   /* f is declared NONE */
+    SL_CHECK(sl_params_set_numbers(&b, "v", (double[]){0.1, 0.2, 0.35}, 3, &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_FRAME);
+    SL_CHECK(sl_params_set_numbers(&b, "b", (double[]){0}, 1, &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_PREPARED);
+    SL_CHECK(sl_params_set_choice(&b, "e", "apple", &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_DATASET);
+    SL_CHECK(sl_params_set_choice(&b, "e", "banana", &err) == SL_OK);  /* back to the default */
+    SL_CHECK(sl_params_compare(&a, &b) == SL_INVALIDATE_PREPARED);
+
+    /* A different schema counts as PREPARED. */
+    int n = 0;
+    const sl_technique *const *list = sl_technique_list(&n);
+    sl_params other;
+    sl_params_init(&other, list[0]->params, list[0]->param_count);
+    SL_CHECK(sl_params_compare(&a, &other) == SL_INVALIDATE_PREPARED);
+    sl_params shorter;
+    sl_params_init(&shorter, test_schema, TEST_COUNT - 1);
+    SL_CHECK(sl_params_compare(&a, &shorter) == SL_INVALIDATE_PREPARED);
+
+    /* Type names. */
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_FLOAT), "float") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_INT), "int") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_BOOL), "bool") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_ENUM), "enum") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_VEC3), "vec3") == 0);
+
+    /* A concrete message, word for word where it matters. */
+    sl_params_init(&p, test_schema, TEST_COUNT);
+    SL_CHECK(sl_params_set_numbers(&p, "f", (double[]){11}, 1, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "'f'") && strstr(err.message, "11") && strstr(err.message, "[-2.5, 10]") &&
+                 strstr(err.message, "world"), "%s", err.message);
+    SL_CHECK(err.status == SL_ERR_INVALID);
+}
+
+/* The technique schemas' shared names: a few declared facts the rest of the code relies on. */
+static void test_known_parameters(void)
+{
+    const sl_technique *t = sl_technique_find("tubes_mesh");
+    SL_CHECK(t != NULL);
+    if (!t)
+        return;
+    sl_params p;
+    sl_params_init(&p, t->params, t->param_count);
+    int r = sl_params_find(&p, "radius"), s = sl_params_find(&p, "sides"), c = sl_params_find(&p, "colormap");
+    SL_CHECK(r >= 0 && s >= 0 && c >= 0);
+    if (r < 0 || s < 0 || c < 0)
+        return;
+    SL_CHECK(t->params[r].type == SL_PARAM_FLOAT && t->params[r].invalidates == SL_INVALIDATE_FRAME);
+    SL_CHECK(t->params[s].type == SL_PARAM_INT && t->params[s].invalidates == SL_INVALIDATE_PREPARED);
+    sl_err err = {0};
+    cJSON *patch = cJSON_Parse("{\"radius\": 0.5, \"colormap\": \"magma\", \"sides\": 7}");
+    sl_params q = p;
+    SL_CHECK_MSG(sl_params_apply_json(&q, patch, &err) == SL_OK, "%s", err.message);
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_float(&q, "radius") == 0.5);
+    SL_CHECK(strcmp(sl_params_choice_name(&q, "colormap"), "magma") == 0);
+    SL_CHECK(sl_params_int(&q, "sides") == 7);
+    SL_CHECK(sl_params_compare(&p, &q) == SL_INVALIDATE_PREPARED);
+    patch = cJSON_Parse("{\"radius\": -0.5}");
+    SL_CHECK(sl_params_apply_json(&q, patch, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "'radius'") && strstr(err.message, "-0.5") && strstr(err.message, "[0, 1e+09]"),
+                 "%s", err.message);
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_float(&q, "radius") == 0.5);
+}
+
+int main(void)
+{
+    test_techniques();
+    test_private_schema();
+    test_known_parameters();
+    SL_TEST_END();
+}
