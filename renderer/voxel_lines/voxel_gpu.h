@@ -1,8 +1,9 @@
 /* voxel_gpu.h — the voxel model built on the GPU with compute shaders
  * (voxelize_gpu.c; Kanzler et al., Sec. 3.3). Same result as
- * sl_voxel_grid_build (voxel_grid.h) with desc->attribute = -1: equal
- * headers, equal bit-packed lines in the same order, densities within float
- * rounding. Not counted: grid->degenerate. Render thread only (GL context).
+ * sl_voxel_grid_build (voxel_grid.h) for the same desc, colour attribute
+ * included: equal headers, equal bit-packed lines (attribute bytes too) in
+ * the same order, densities within float rounding. Not counted:
+ * grid->degenerate. Render thread only (GL context).
  */
 #ifndef SL_VOXEL_GPU_H
 #define SL_VOXEL_GPU_H

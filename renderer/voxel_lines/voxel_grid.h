@@ -12,8 +12,8 @@
  * a header holds a 32-bit offset and an 8-bit count; a voxel with more lines
  * than max_per_voxel keeps its first ones in curve order and the rest are
  * counted in dropped_overflow — never wrapped.
- * CPU only, any thread, no GL. The GPU build (voxelize_gpu.c) must produce
- * the same set of encoded lines per voxel.
+ * CPU only, any thread, no GL. The GPU build (voxelize_gpu.c) produces the
+ * same encoded lines per voxel, attribute byte included.
  */
 #ifndef SL_VOXEL_GRID_H
 #define SL_VOXEL_GRID_H
@@ -109,6 +109,27 @@ typedef struct sl_voxel_line {
 uint64_t sl_voxel_encode_line(int k, const sl_voxel_line *line);
 void sl_voxel_decode_line(int k, uint64_t code, sl_voxel_line *line);
 
+/* --- Attribute byte --------------------------------------------------------
+ * One definition for the CPU and the GPU build, bit for bit:
+ *  1. per vertex (on the CPU, sl_voxel_attr_normalize, in both builds):
+ *     a_i = ((double)v_i - (double)min) / ((double)max - (double)min), or 0
+ *     when v_i is not finite or max <= min;
+ *  2. at a face crossing at segment parameter t (the clipping's own double):
+ *     a = a_i + t * (a_{i+1} - a_i), in that order, no fused multiply-add;
+ *  3. per piece (sl_voxel_attr_byte): m = 0.5 * (a_entry + a_exit), clamped
+ *     to [0, 1], y = m * 255, byte = floor(y) + (y - floor(y) >= 0.5) — i.e.
+ *     round half up (= lround(y)), written out so GLSL can do the same.
+ * Steps 2 and 3 use only IEEE double add, subtract, multiply and floor
+ * (exact or correctly rounded; the shader marks them `precise`), the only
+ * division is done on the CPU and uploaded, so voxelize_gpu.comp.glsl
+ * reproduces the bytes exactly. */
+
+/* out[i] = a_i of values[i] (step 1) for the per-vertex attribute at; n values. */
+void sl_voxel_attr_normalize(const sl_attribute *at, const float *values, size_t n, double *out);
+
+/* The attribute byte of a piece from its entry and exit values (step 3). */
+uint32_t sl_voxel_attr_byte(double attr_a, double attr_b);
+
 /* --- The built grid ------------------------------------------------------ */
 
 typedef struct sl_voxel_grid_desc {
@@ -117,7 +138,7 @@ typedef struct sl_voxel_grid_desc {
     int padding;          /* empty voxels on each side; < 0 = 1 */
     int max_per_voxel;    /* 1..255; 0 = 255 */
     int attribute;        /* per-vertex attribute index for the attribute byte (normalized to
-                           * its range); -1 or out of range = none (byte 0) */
+                           * its range, see "Attribute byte"); -1 or out of range = none (byte 0) */
 } sl_voxel_grid_desc;
 
 typedef struct sl_voxel_grid {

@@ -3,13 +3,15 @@
  * Pipeline for Large 3D Line Sets", TVCG 2018).
  *
  * prepare voxelizes on the CPU (voxelize_cpu.c: exact clipping, face
- * quantization, bit packing, 5-byte headers) and uploads headers, lines and
- * the per-voxel density with its mip chain (the density LoD). render casts
- * one ray per pixel in a full-screen fragment pass (voxel_lines.frag.glsl).
- * A camera move only renders; radius, opacity and shading are uniforms; AO
- * is recomputed (compute shader) only when it is on and opacity, radius or
- * its own parameters changed; the attribute byte is rebuilt when the colour
- * attribute changes. Grid resolution, quantization and the per-voxel cap
+ * quantization, bit packing, 5-byte headers) or, with `voxelize = gpu`,
+ * with compute shaders (voxelize_gpu.c: the same lines, attribute byte
+ * included) and uploads headers, lines and the per-voxel density with its
+ * mip chain (the density LoD). render casts one ray per pixel in a
+ * full-screen fragment pass (voxel_lines.frag.glsl). A camera move only
+ * renders; radius, opacity and shading are uniforms; AO is recomputed
+ * (compute shader) only when it is on and opacity, radius or its own
+ * parameters changed; the grid is rebuilt (by the chosen build) when the
+ * colour attribute changes. Grid resolution, quantization and the per-voxel cap
  * re-prepare. Data radii are not used (one radius for all tubes). Lines
  * dropped by the per-voxel cap are reported once per build on stderr.
  * Render thread only. Limits: README.md.
@@ -29,7 +31,7 @@
 
 static const char *const quant_choices[] = {"2", "4", "8", "16", "32", "64", "128", "256", NULL};
 static const char *const neighbor_choices[] = {"auto", "own", "always", NULL};
-static const char *const build_choices[] = {"cpu", "gpu", NULL};
+static const char *const build_choices[] = {"auto", "cpu", "gpu", NULL};
 static const char *const shadow_choices[] = {"soft", "lines", NULL};
 static const char *const opacity_tf_choices[] = {"constant", "ramp", NULL};
 
@@ -46,8 +48,8 @@ static const sl_param_def voxel_lines_params[] = {
     {"quantization", SL_PARAM_ENUM, 0, 0, {4}, quant_choices, "bins",
      "face subdivision N (N x N bins per voxel face)", SL_INVALIDATE_PREPARED},
     {"voxelize", SL_PARAM_ENUM, 0, 0, {0}, build_choices, "",
-     "where to voxelize: cpu, or gpu (compute shaders; without an attribute byte, so a colour attribute "
-     "falls back to cpu)", SL_INVALIDATE_PREPARED},
+     "where to voxelize: auto (gpu on a hardware GPU, cpu on a software renderer, where the CPU build is ~10x faster), cpu, or gpu (compute shaders; the same lines)",
+     SL_INVALIDATE_PREPARED},
     {"max_lines_per_voxel", SL_PARAM_INT, 1, 255, {255}, NULL, "",
      "cap per voxel (the header count is 8 bits); further lines are dropped and counted", SL_INVALIDATE_PREPARED},
     {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {0.99}, NULL, "", "early ray termination at this opacity",
@@ -75,7 +77,7 @@ typedef struct voxel_lines_state {
     const sl_dataset *dataset;  /* borrowed */
     sl_voxel_frame frame;
     int resolution;             /* the `grid` parameter (0 = automatic) */
-    int use_gpu;                /* voxelize with compute shaders when no attribute is used */
+    int use_gpu;                /* voxelize with compute shaders (voxelize = gpu) */
     int quant, quant_bits, line_bits, max_per_voxel;
     int built_attribute;        /* attribute index of the uploaded attribute bytes, or -1 */
     size_t voxel_count, line_count, grid_bytes;
@@ -226,8 +228,8 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     sl_voxel_grid g;
     sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = 1,
                                .max_per_voxel = s->max_per_voxel, .attribute = attribute};
-    sl_status st = s->use_gpu && attribute < 0 ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
-                                               : sl_voxel_grid_build(&g, s->dataset, &desc, err);
+    sl_status st = s->use_gpu ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
+                              : sl_voxel_grid_build(&g, s->dataset, &desc, err);
     if (st != SL_OK)
         return st;
     release_grid(s);
@@ -332,7 +334,8 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     s->quant = atoi(sl_params_choice_name(params, "quantization"));
     s->max_per_voxel = sl_params_int(params, "max_lines_per_voxel");
     s->resolution = sl_params_int(params, "grid");
-    s->use_gpu = sl_params_choice(params, "voxelize") == 1;
+    int build = sl_params_choice(params, "voxelize");
+    s->use_gpu = build == 2 || (build == 0 && !sl_gpu_is_software(gpu));
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
     sl_status st = build_and_upload(s, style.attribute, err);

@@ -122,6 +122,7 @@ static void clip_segment(clip_state *s, const double a[3], const double b[3], do
                 p[ax] = clampd(p[ax], (double)s->cell[ax], (double)(s->cell[ax] + 1));
             }
         }
+        /* Attribute at the crossing (voxel_grid.h, step 2; mirrored in voxelize_gpu.comp.glsl). */
         double attr = attr_a + tmin * (attr_b - attr_a);
         int up = d[first_axis] > 0.0;
         emit(s, p, 2 * first_axis + (up ? 1 : 0), attr);
@@ -266,6 +267,29 @@ sl_status sl_voxel_frame_init(sl_voxel_frame *f, const sl_dataset *ds, int resol
     return SL_OK;
 }
 
+/* --- Attribute byte (definition: voxel_grid.h) ----------------------------- */
+
+void sl_voxel_attr_normalize(const sl_attribute *at, const float *values, size_t n, double *out)
+{
+    double amin = (double)at->min, aspan = (double)at->max - (double)at->min;
+    for (size_t i = 0; i < n; i++) {
+        double v = (double)values[i];
+        out[i] = aspan > 0.0 && isfinite(v) ? (v - amin) / aspan : 0.0;
+    }
+}
+
+uint32_t sl_voxel_attr_byte(double attr_a, double attr_b)
+{
+    double m = 0.5 * (attr_a + attr_b);
+    if (!(m > 0.0))
+        m = 0.0;
+    if (m > 1.0)
+        m = 1.0;
+    double y = m * 255.0;
+    double q = floor(y);
+    return (uint32_t)q + (y - q >= 0.5 ? 1u : 0u);
+}
+
 /* --- Build ---------------------------------------------------------------- */
 
 typedef struct build_item {
@@ -296,8 +320,7 @@ static int collect(void *user, const sl_voxel_piece *p)
         .bin_b = sl_voxel_quantize(ub, p->face_b, b->quant),
         .id = p->curve & ((1u << SL_VOXEL_LINE_ID_BITS) - 1),
     };
-    double attr = 0.5 * (p->attr_a + p->attr_b);
-    line.attr = (uint32_t)lround(clampd(attr, 0.0, 1.0) * 255.0);
+    line.attr = sl_voxel_attr_byte(p->attr_a, p->attr_b);
     if (line.face_a == line.face_b && line.bin_a == line.bin_b) {
         b->degenerate++;
         return 0;
@@ -375,15 +398,13 @@ sl_status sl_voxel_grid_build(sl_voxel_grid *g, const sl_dataset *ds, const sl_v
         goto fail;
     }
     const sl_attribute *at = g->attribute_index >= 0 ? &l->attributes[g->attribute_index] : NULL;
-    double amin = at ? at->min : 0.0, aspan = at ? (double)at->max - at->min : 0.0;
     for (size_t c = 0; c < l->line_count; c++) {
         size_t first = l->line_offsets[c], n = l->line_offsets[c + 1] - first;
-        for (size_t i = 0; i < n; i++) {
+        for (size_t i = 0; i < n; i++)
             for (int ax = 0; ax < 3; ax++)
                 pts[3 * i + ax] = ((double)l->positions[3 * (first + i) + ax] - g->frame.lo[ax]) / g->frame.h;
-            double v = at ? (double)at->values[first + i] : 0.0;
-            attr[i] = aspan > 0.0 && isfinite(v) ? (v - amin) / aspan : 0.0;
-        }
+        if (at)
+            sl_voxel_attr_normalize(at, at->values + first, n, attr);
         size_t before = b.count;
         sl_voxel_clip_stats cs = {0};
         st = sl_voxel_clip_polyline(g->frame.dims, pts, at ? attr : NULL, n, (uint32_t)c, collect, &b, &cs, err);

@@ -6,10 +6,13 @@
  * bit-pack and sum lengths. The exclusive scans between passes (over curves;
  * over voxels, uncapped and capped) run on the GPU (voxel_scan.comp.glsl);
  * counts are read back only for statistics and the CPU copy of the headers.
- * The result is read back into a
- * CPU sl_voxel_grid equal to sl_voxel_grid_build's (test_voxel_gpu checks
- * it) except: no attribute byte (always 0) and `degenerate` is not counted.
- * Render thread only (needs the GL context).
+ * With a colour attribute the per-vertex normalized values (the one division
+ * of the attribute byte's definition, voxel_grid.h) are computed here with
+ * sl_voxel_attr_normalize and uploaded as doubles; the shader interpolates
+ * and rounds them exactly as voxelize_cpu.c. The result is read back into a
+ * CPU sl_voxel_grid equal to sl_voxel_grid_build's, attribute bytes included
+ * (tests/render/voxel_lines/voxel_gpu_build.c checks it), except that
+ * `degenerate` is not counted. Render thread only (needs the GL context).
  */
 #include "voxel_gpu.h"
 
@@ -93,10 +96,10 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     g->quant_bits = k;
     g->line_bytes = sl_voxel_line_bytes(k);
     g->voxel_count = (size_t)g->frame.dims[0] * g->frame.dims[1] * g->frame.dims[2];
-    g->attribute_index = -1;
+    g->attribute_index = d.attribute >= 0 && d.attribute < l->attribute_count ? d.attribute : -1;
 
     GLuint prog[PASSES] = {0}, scan_prog[2] = {0};
-    GLuint buf[10] = {0};
+    GLuint buf[11] = {0};
     uint32_t *curve_counts = NULL, *voxel_counts = NULL, *line_starts = NULL;
     for (int p = 0; p < PASSES && st == SL_OK; p++) {
         char defines[64], label[32];
@@ -118,6 +121,21 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     buf[0] = ssbo(l->vertex_count * 3 * sizeof(float), l->positions);
     buf[1] = ssbo((curves + 1) * sizeof(uint32_t), l->line_offsets);
     buf[2] = ssbo((curves + 1) * sizeof(uint32_t), NULL);
+    if (g->attribute_index >= 0) {
+        /* Step 1 of the attribute byte on the CPU (voxel_grid.h); bound at 10. */
+        const sl_attribute *at = &l->attributes[g->attribute_index];
+        double *norm = malloc((l->vertex_count ? l->vertex_count : 1) * sizeof *norm);
+        if (!norm) {
+            st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization: out of memory for %zu attribute values",
+                            l->vertex_count);
+            goto fail;
+        }
+        sl_voxel_attr_normalize(at, at->values, l->vertex_count, norm);
+        buf[10] = ssbo(l->vertex_count * sizeof *norm, norm);
+        free(norm);
+    } else {
+        buf[10] = ssbo(sizeof(double), NULL); /* unread: u_has_attr = 0 */
+    }
     for (int p = 0; p < PASSES; p++) {
         GLuint pr = prog[p];
         glUseProgram(pr);
@@ -128,9 +146,11 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
         glUniform1i(glGetUniformLocation(pr, "u_k"), k);
         glUniform1ui(glGetUniformLocation(pr, "u_cap"), (GLuint)d.max_per_voxel);
         glUniform1i(glGetUniformLocation(pr, "u_line_bits"), 8 * g->line_bytes);
+        glUniform1i(glGetUniformLocation(pr, "u_has_attr"), g->attribute_index >= 0);
     }
     for (int b = 0; b < 3; b++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)b, buf[b]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, buf[10]);
 
     /* 1: pieces per curve; their exclusive scan (GPU) gives each curve's
      * first item. The counts are read back only for statistics. */
@@ -174,6 +194,8 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, buf[3]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, buf[4]);
     run(prog[1], (GLuint)curves);
+    glDeleteBuffers(1, &buf[10]); /* the attribute values are read by EMIT only */
+    buf[10] = 0;
     run(prog[2], (GLuint)total);
     voxel_counts = malloc(g->voxel_count * sizeof *voxel_counts);
     line_starts = malloc((g->voxel_count + 1) * sizeof *line_starts);
@@ -238,7 +260,7 @@ done:
     for (int p = 0; p < 2; p++)
         if (scan_prog[p])
             glDeleteProgram(scan_prog[p]);
-    for (int b = 0; b < 10; b++)
+    for (int b = 0; b < 11; b++)
         if (buf[b])
             glDeleteBuffers(1, &buf[b]);
     free(curve_counts);

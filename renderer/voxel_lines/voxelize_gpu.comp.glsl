@@ -1,7 +1,10 @@
 // voxelize_gpu.comp.glsl — GPU voxelization of curves (Kanzler et al., Sec. 3.3),
 // the same model as voxelize_cpu.c, bit for bit: the clipping runs in double
 // precision with `precise` arithmetic in the same order as the C code, so the
-// quantized endpoints agree. One source, four entry points chosen by VX_PASS:
+// quantized endpoints agree; the attribute byte (definition in voxel_grid.h)
+// interpolates the per-vertex normalized values the C side uploads (vx_attr)
+// at the crossings and rounds their mean with the same double operations.
+// One source, five entry points chosen by VX_PASS:
 //   1 COUNT   per curve: number of kept (non-degenerate) pieces
 //   2 EMIT    per curve: (voxel, code) items at the curve's offset (curve order)
 //   3 HISTO   per item: voxel histogram (atomicAdd)
@@ -10,7 +13,7 @@
 //             cap keeps the same lines as the CPU), pack the first `cap` codes
 //             into the line words (atomicOr: bits of one line are written by
 //             one invocation only) and sum their lengths (density).
-// Scans between passes run on the CPU (voxelize_gpu.c).
+// The exclusive scans between passes run in voxel_scan.comp.glsl.
 layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer vx_positions { float positions[]; };
@@ -23,6 +26,7 @@ layout(std430, binding = 6) buffer vx_slots { uint slots[]; };
 layout(std430, binding = 7) readonly buffer vx_line_starts { uint line_starts[]; };   // capped scan
 layout(std430, binding = 8) buffer vx_words { uint words[]; };
 layout(std430, binding = 9) buffer vx_density { float density[]; };
+layout(std430, binding = 10) readonly buffer vx_attributes { double vx_attr[]; }; // per vertex, normalized
 
 uniform dvec3 u_lo;
 uniform double u_h;
@@ -32,6 +36,7 @@ uniform int u_k;
 uniform uint u_count;        // curves, items or voxels, by pass
 uniform uint u_cap;
 uniform int u_line_bits;
+uniform bool u_has_attr;     // vx_attr holds the chosen attribute; else every value is 0
 
 uint g_kept;
 uint g_out;
@@ -55,13 +60,52 @@ uint quantize(dvec3 u, int face)
     return quantize1(u[s]) + uint(u_quant) * quantize1(u[t]);
 }
 
+// Normalized attribute of vertex v (voxel_grid.h, step 1: computed on the CPU).
+double vertex_attr(uint v)
+{
+#if VX_PASS == 2
+    return u_has_attr ? vx_attr[v] : 0.0LF;
+#else
+    return 0.0LF; // only EMIT writes attribute bytes
+#endif
+}
+
+// Attribute byte of a piece (sl_voxel_attr_byte, step 3): round half up of
+// 255 x the clamped mean, with the same double operations as the C code.
+uint attr_byte(double attr_a, double attr_b)
+{
+    precise double m = 0.5LF * (attr_a + attr_b);
+    if (!(m > 0.0LF))
+        m = 0.0LF;
+    if (m > 1.0LF)
+        m = 1.0LF;
+    precise double y = m * 255.0LF;
+    precise double q = floor(y);
+    precise double frac = y - q;
+    return uint(q) + (frac >= 0.5LF ? 1u : 0u);
+}
+
+// ORs `value` into the 64-bit record (lo, hi) at bit `shift` (< 64; the
+// value's bits above 64 - shift must be 0).
+void put_bits(inout uint lo, inout uint hi, uint value, uint shift)
+{
+    if (shift >= 32u) {
+        hi |= value << (shift - 32u);
+    } else {
+        lo |= value << shift;
+        if (shift > 0u)
+            hi |= value >> (32u - shift);
+    }
+}
+
 // State of the walk (as clip_state in voxelize_cpu.c).
 ivec3 g_cell;
 bool g_have_entry;
 dvec3 g_entry;
 int g_entry_face;
+double g_entry_attr;
 
-void emit_piece(dvec3 p, int exit_face)
+void emit_piece(dvec3 p, int exit_face, double attr)
 {
     if (!g_have_entry)
         return;
@@ -73,35 +117,30 @@ void emit_piece(dvec3 p, int exit_face)
         return; // collapsed by quantization
 #if VX_PASS == 2
     uint eb = uint(3 + 2 * u_k);
-    // Up to 2 * 19 + 13 = 51 bits: lo word and hi word.
-    uint a = uint(g_entry_face) | (ba << 3u), b = uint(exit_face) | (bb << 3u);
-    uint id = g_curve & 31u; // attribute byte: 0 (the GPU build carries no attribute)
-    uint lo = a | (b << eb);
-    uint hi = b >> (32u - eb);
-    uint ib = 2u * eb + 8u;
-    if (ib < 32u) {
-        lo |= id << ib;
-        if (ib + 5u > 32u)
-            hi |= id >> (32u - ib);
-    } else {
-        hi |= id << (ib - 32u);
-    }
+    // Up to 2 * 19 + 13 = 51 bits: lo word and hi word, packed as
+    // sl_voxel_encode_line: face_a bin_a face_b bin_b attr(8) id(5).
+    uint lo = 0u, hi = 0u;
+    put_bits(lo, hi, uint(g_entry_face) | (ba << 3u), 0u);
+    put_bits(lo, hi, uint(exit_face) | (bb << 3u), eb);
+    put_bits(lo, hi, attr_byte(g_entry_attr, attr), 2u * eb);
+    put_bits(lo, hi, g_curve & 31u, 2u * eb + 8u);
     int v = g_cell.x + u_dims.x * (g_cell.y + u_dims.y * g_cell.z);
     items[g_out++] = uvec4(uint(v), lo, hi, 0u);
 #endif
     g_kept++;
 }
 
-void set_entry(dvec3 p, int face)
+void set_entry(dvec3 p, int face, double attr)
 {
     g_have_entry = true;
     g_entry = p;
     g_entry_face = face;
+    g_entry_attr = attr;
 }
 
 double clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
-void clip_segment(dvec3 a, dvec3 b)
+void clip_segment(dvec3 a, dvec3 b, double attr_a, double attr_b)
 {
     precise dvec3 d = b - a;
     bvec3 blocked = bvec3(false);
@@ -149,15 +188,17 @@ void clip_segment(dvec3 a, dvec3 b)
                 p[ax] = clampd(p[ax], double(g_cell[ax]), double(g_cell[ax] + 1));
             }
         }
+        // Attribute at the crossing (voxel_grid.h, step 2), as voxelize_cpu.c.
+        precise double attr = attr_a + tmin * (attr_b - attr_a);
         bool up = d[first_axis] > 0.0LF;
-        emit_piece(p, 2 * first_axis + (up ? 1 : 0));
+        emit_piece(p, 2 * first_axis + (up ? 1 : 0), attr);
         if (out_of_grid) {
             g_have_entry = false;
             g_cell = next;
             continue;
         }
         g_cell = next;
-        set_entry(p, 2 * first_axis + (up ? 0 : 1));
+        set_entry(p, 2 * first_axis + (up ? 0 : 1), attr);
     }
 }
 
@@ -190,15 +231,18 @@ void clip_curve(uint c)
             continue;
         for (int ax = 0; ax < 3; ax++)
             if (a[ax] == double(g_cell[ax]) && d[ax] > 0.0LF) {
-                set_entry(a, 2 * ax);
+                set_entry(a, 2 * ax, vertex_attr(first));
                 break;
             }
         break;
     }
+    double attr_a = vertex_attr(first);
     for (uint i = 1u; i < n; i++) {
         dvec3 b = grid_point(first + i);
-        clip_segment(a, b);
+        double attr_b = vertex_attr(first + i);
+        clip_segment(a, b, attr_a, attr_b);
         a = b;
+        attr_a = attr_b;
     }
 }
 

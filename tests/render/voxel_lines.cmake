@@ -20,12 +20,19 @@ voxel_render_test(voxel_lines.depth_vs_tubes_mesh
 voxel_render_test(voxel_lines.transparent_vs_lines_oit
   voxel-check oit --size 128 --grid 64 --quant 256 --opacity 0.25 --tol-mean 1.5 --tol-p99 25)
 
-# The compute-shader voxelization equals the CPU one (headers, packed lines, caps, density).
+# The compute-shader voxelization equals the CPU one (headers, packed lines
+# including the attribute byte, caps, density), without and with a colour
+# attribute (tornado speed, bundle curvature / radial, hostile values).
 add_executable(voxel-gpu-build ${VOXEL_DIR}/voxel_gpu_build.c)
 target_include_directories(voxel-gpu-build PRIVATE ${CMAKE_SOURCE_DIR}/tests/unit)
 target_link_libraries(voxel-gpu-build PRIVATE sightline_proto sightline_renderer)
 set_target_properties(voxel-gpu-build PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
 voxel_render_test(voxel_lines.gpu_build_equals_cpu voxel-gpu-build)
+
+# End to end: the transparent scene coloured by tornado speed (attribute 0),
+# voxelized on the GPU (no CPU fallback) and on the CPU: identical frames.
+voxel_render_test(voxel_lines.gpu_build_colour_image
+  sh -c "$<TARGET_FILE:sightline-render> --scene ${VOXEL_DIR}/transparent.json --out ${SL_RENDER_OUT}/voxel_colour_cpu.png --samples 1 --set params.attribute=0 --set params.voxelize=cpu && $<TARGET_FILE:sightline-render> --scene ${VOXEL_DIR}/transparent.json --out ${SL_RENDER_OUT}/voxel_colour_gpu.png --samples 1 --set params.attribute=0 --set params.voxelize=gpu && $<TARGET_FILE:sightline-diff> ${SL_RENDER_OUT}/voxel_colour_cpu.png ${SL_RENDER_OUT}/voxel_colour_gpu.png --max-abs 0")
 
 # Empty-space skipping changes nothing; full-strength shadows and AO darken.
 voxel_render_test(voxel_lines.effects

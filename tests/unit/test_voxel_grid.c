@@ -5,8 +5,9 @@
  * quantization (error <= 0.5/N per in-face axis), bit packing (round trip,
  * 4/5/6 bytes per line as in the paper's Sec. 5.2), header invariants, the
  * overflow cap (never wraps, counts reported), lines on faces, edges and
- * corners, axis-parallel lines, zero-length pieces, bad input and a dataset
- * 1e6 units from the origin. CPU only.
+ * corners, axis-parallel lines, zero-length pieces, bad input, a dataset
+ * 1e6 units from the origin, and the attribute byte's definition
+ * (normalization, round half up = lround). CPU only.
  */
 #include <math.h>
 #include <stdint.h>
@@ -155,6 +156,46 @@ static void test_encode(void)
     SL_CHECK(sl_voxel_line_bytes(2) == 4 && sl_voxel_line_bytes(3) == 4);
     SL_CHECK(sl_voxel_line_bytes(4) == 5 && sl_voxel_line_bytes(5) == 5);
     SL_CHECK(sl_voxel_line_bytes(6) == 6 && sl_voxel_line_bytes(7) == 6);
+}
+
+/* The attribute byte (voxel_grid.h): per-vertex normalization and the
+ * written-out round half up, which must equal lround of the clamped mean
+ * (the CPU build's earlier definition), ties and neighbours of ties included. */
+static void test_attr_byte(void)
+{
+    float values[7] = {1.0f, 2.0f, 3.0f, NAN, INFINITY, 5.0f, -1.0f};
+    sl_attribute at = {.values = values, .min = 1.0f, .max = 3.0f};
+    double out[7];
+    sl_voxel_attr_normalize(&at, values, 7, out);
+    SL_CHECK(out[0] == 0.0 && out[1] == 0.5 && out[2] == 1.0 && out[3] == 0.0 && out[4] == 0.0);
+    SL_CHECK(out[5] == 2.0 && out[6] == -1.0);
+    at.max = at.min; /* constant attribute: all 0 */
+    sl_voxel_attr_normalize(&at, values, 7, out);
+    int zero = 1;
+    for (int i = 0; i < 7; i++)
+        zero &= out[i] == 0.0;
+    SL_CHECK(zero);
+
+    SL_CHECK(sl_voxel_attr_byte(0.0, 0.0) == 0 && sl_voxel_attr_byte(1.0, 1.0) == 255);
+    SL_CHECK(sl_voxel_attr_byte(0.0, 1.0) == 128);   /* 127.5: half up */
+    SL_CHECK(sl_voxel_attr_byte(-3.0, -1.0) == 0 && sl_voxel_attr_byte(2.0, 4.0) == 255);
+    SL_CHECK(sl_voxel_attr_byte(-1.0, 1.0) == 0 && sl_voxel_attr_byte(0.5, 2.0) == 255);
+    int same = 1;
+    for (int k = 0; k <= 255 && same; k++)
+        for (int h = 0; h < 2; h++) {
+            double m = (k + 0.5 * h) / 255.0;
+            double probe[3] = {nextafter(m, -1.0), m, nextafter(m, 2.0)};
+            for (int j = 0; j < 3; j++) {
+                double x = probe[j];
+                long want = lround(fmin(fmax(x, 0.0), 1.0) * 255.0);
+                same &= (long)sl_voxel_attr_byte(x, x) == want;
+            }
+        }
+    for (int i = 0; i < 100000 && same; i++) {
+        double a = rnd() * 1.2 - 0.1, b = rnd() * 1.2 - 0.1;
+        same &= (long)sl_voxel_attr_byte(a, b) == lround(fmin(fmax(0.5 * (a + b), 0.0), 1.0) * 255.0);
+    }
+    SL_CHECK(same);
 }
 
 static void test_quantize(void)
@@ -568,6 +609,7 @@ int main(void)
     test_degenerate_data();
     test_quality();
     test_encode();
+    test_attr_byte();
     test_quantize();
     test_clip_random();
     test_clip_stress();
