@@ -22,6 +22,8 @@ typedef struct obj_build {
     float *points;          /* 3 * point_count */
     uint64_t *offsets;      /* line_count + 1 */
     uint32_t *indices;      /* index_count */
+    double lo[3], hi[3];    /* bounds of the points (counting pass) */
+    double centre[3];       /* points are stored relative to it (dataset origin) */
 } obj_build;
 
 /* One pass over the file; with b->points NULL it only counts. */
@@ -53,9 +55,16 @@ static sl_status walk(const uint8_t *d, size_t size, obj_build *b, sl_err *err)
             }
             if (points >= SL_MAX_VERTICES)
                 return sl_err_set(err, SL_ERR_LIMIT, "line %zu: more than %u vertices", lineno, SL_MAX_VERTICES);
-            if (fill)
-                for (int c = 0; c < 3; c++)
-                    b->points[3 * points + c] = (float)xyz[c];
+            /* Narrowed only relative to the bounds centre, so data far from
+             * the origin keeps float precision (sl_dataset.h). */
+            for (int c = 0; c < 3; c++) {
+                if (fill)
+                    b->points[3 * points + c] = (float)(xyz[c] - b->centre[c]);
+                else if (points == 0 || xyz[c] < b->lo[c])
+                    b->lo[c] = xyz[c];
+                if (!fill && (points == 0 || xyz[c] > b->hi[c]))
+                    b->hi[c] = xyz[c];
+            }
             points++;
         } else if (len == 1 && tok[0] == 'l') {
             size_t n = 0;
@@ -115,6 +124,8 @@ sl_status sl_load_obj(const uint8_t *data, size_t size, const char *path, sl_dat
     sl_status st = walk(data, size, &b, err);
     if (st != SL_OK)
         goto fail;
+    for (int c = 0; c < 3; c++)
+        b.centre[c] = b.point_count ? 0.5 * (b.lo[c] + b.hi[c]) : 0.0;
     b.points = malloc(3 * (b.point_count ? b.point_count : 1) * sizeof(float));
     b.offsets = calloc(b.line_count + 1, sizeof *b.offsets);
     b.indices = malloc((b.index_count ? b.index_count : 1) * sizeof *b.indices);
@@ -132,6 +143,7 @@ sl_status sl_load_obj(const uint8_t *data, size_t size, const char *path, sl_dat
         st = sl_err_set(err, SL_ERR_NOMEM, "out of memory for the dataset");
         goto fail;
     }
+    ds->origin = sl_v3(b.centre[0], b.centre[1], b.centre[2]);
     st = sl_lines_from_indexed(ds, b.points, b.point_count, b.offsets, b.line_count, b.indices, err);
     if (st == SL_OK)
         st = sl_dataset_finish_lines(ds, err);

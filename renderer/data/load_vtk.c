@@ -28,7 +28,7 @@
 
 typedef enum vtype { VT_U8, VT_S8, VT_U16, VT_S16, VT_U32, VT_S32, VT_U64, VT_S64, VT_F32, VT_F64 } vtype;
 
-typedef enum dst_kind { DST_SKIP, DST_F32, DST_I64, DST_U8, DST_U16, DST_S16 } dst_kind;
+typedef enum dst_kind { DST_SKIP, DST_F32, DST_F64, DST_I64, DST_U8, DST_U16, DST_S16 } dst_kind;
 
 static const struct { const char *name; vtype t; } vtk_types[] = {
     {"unsigned_char", VT_U8}, {"char", VT_S8}, {"unsigned_short", VT_U16}, {"short", VT_S16},
@@ -200,6 +200,9 @@ static sl_status read_values(vtk *p, vtype t, size_t count, dst_kind kind, void 
             break;
         case DST_F32:
             ((float *)dst)[i] = sl_load_narrow(v);
+            break;
+        case DST_F64:
+            ((double *)dst)[i] = v;
             break;
         case DST_I64:
             if (!(v >= -9007199254740992.0 && v <= 9007199254740992.0) || v != floor(v))
@@ -609,7 +612,8 @@ static sl_status read_attribute(vtk *p, const char *tok, size_t len, size_t n, a
 
 typedef struct poly {
     size_t point_count;
-    float *points;
+    float *points;              /* relative to centre */
+    double centre[3];           /* bounds centre of the points, the dataset origin */
     cells lines;
     int have_lines;
     size_t cells_before_lines;  /* VERTICES precede LINES in cell numbering */
@@ -617,6 +621,37 @@ typedef struct poly {
     size_t cell_data_n;         /* tuples in each cell_data array */
     attr_set point_data, cell_data;
 } poly;
+
+/* Reads POINTS in double and keeps them as float relative to their bounds
+ * centre, so data far from the origin keeps float precision (sl_dataset.h). */
+static sl_status read_points(vtk *p, vtype t, poly *g)
+{
+    size_t n = 3 * g->point_count;
+    double *xyz = malloc((n ? n : 1) * sizeof *xyz);
+    g->points = malloc((n ? n : 1) * sizeof(float));
+    if (!xyz || !g->points) {
+        free(xyz);
+        return fail(p, SL_ERR_NOMEM, "POINTS: out of memory for %zu points", g->point_count);
+    }
+    sl_status st = read_values(p, t, n, DST_F64, xyz, "POINTS data");
+    if (st != SL_OK) {
+        free(xyz);
+        return st;
+    }
+    for (int c = 0; c < 3; c++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = (size_t)c; i < n; i += 3)
+            if (isfinite(xyz[i])) {
+                lo = xyz[i] < lo ? xyz[i] : lo;
+                hi = xyz[i] > hi ? xyz[i] : hi;
+            }
+        g->centre[c] = lo <= hi ? 0.5 * (lo + hi) : 0.0;
+        for (size_t i = (size_t)c; i < n; i += 3)
+            g->points[i] = sl_load_narrow(xyz[i] - g->centre[c]);
+    }
+    free(xyz);
+    return SL_OK;
+}
 
 static void poly_free(poly *g)
 {
@@ -655,10 +690,7 @@ static sl_status parse_polydata(vtk *p, poly *g)
             end_line(p);
             if ((st = check_room(p, t, 3 * g->point_count, "POINTS data")) != SL_OK)
                 return st;
-            g->points = malloc((g->point_count ? 3 * g->point_count : 1) * sizeof(float));
-            if (!g->points)
-                return fail(p, SL_ERR_NOMEM, "POINTS: out of memory for %zu points", g->point_count);
-            if ((st = read_values(p, t, 3 * g->point_count, DST_F32, g->points, "POINTS data")) != SL_OK)
+            if ((st = read_points(p, t, g)) != SL_OK)
                 return st;
         } else if (sl_text_is(tok, len, "LINES")) {
             if (!g->points)
@@ -715,6 +747,7 @@ static sl_status parse_polydata(vtk *p, poly *g)
 
 static sl_status build_polydata(poly *g, sl_dataset *ds, sl_err *err)
 {
+    ds->origin = sl_v3(g->centre[0], g->centre[1], g->centre[2]);
     sl_status st = sl_lines_from_indexed(ds, g->points, g->point_count, g->lines.offsets, g->lines.count,
                                          g->lines.indices, err);
     if (st != SL_OK)

@@ -368,9 +368,31 @@ static void test_structured(void)
     }
 }
 
+/* Points far from the origin keep their double precision: the loader stores
+ * them relative to their bounds centre (the dataset origin), so a 1 mm step
+ * at 1e6 survives (as float alone it would snap to 1/16). */
+static void test_polydata_offset(void)
+{
+    const char *text = "# vtk DataFile Version 3.0\noffset\nASCII\nDATASET POLYDATA\n"
+                       "POINTS 3 double\n1000000.001 -2000000.3 5\n1000000.002 -2000000.3 5\n"
+                       "1000000.003 -1999999.3 5.1\nLINES 1 4\n3 0 1 2\n";
+    sl_dataset *ds = load_text(text, "far.vtk", SL_OK, "polydata offset");
+    if (!ds)
+        return;
+    const double want_x[3] = {1000000.001, 1000000.002, 1000000.003};
+    for (int v = 0; v < 3; v++) {
+        double x = ds->origin.x + (double)ds->lines.positions[3 * v];
+        SL_CHECK_MSG(fabs(x - want_x[v]) < 1e-6, "vertex %d x = %.9f, want %.9f", v, x, want_x[v]);
+    }
+    SL_CHECK_NEAR(ds->bounds_min.y, -2000000.3, 1e-6);
+    SL_CHECK_NEAR(ds->bounds_max.y, -1999999.3, 1e-6);
+    sl_dataset_destroy(ds);
+}
+
 int main(void)
 {
     test_polydata();
+    test_polydata_offset();
     test_structured();
     SL_TEST_END();
 }
