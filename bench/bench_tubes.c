@@ -35,7 +35,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "core/sl_line_style.h"
+#include "line_style/sl_line_style.h"
 #include "core/sl_technique.h"
 #include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"

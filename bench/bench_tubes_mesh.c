@@ -39,7 +39,7 @@ typedef struct options {
 static int parse_args(int argc, char **argv, options *o)
 {
     *o = (options){.width = 256, .height = 144, .frames = 5, .sides = {6, 8, 12, 16, 24, 30}, .side_count = 6};
-    for (int i = 1; i < argc; i++) {
+    for (int i = 1; i < argc; i += 2) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(a, "--size") == 0 && v) {
             if (sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width < 16 || o->height < 16 ||
@@ -65,7 +65,6 @@ static int parse_args(int argc, char **argv, options *o)
             fprintf(stderr, "usage: bench-tubes-mesh [--size WxH] [--frames N] [--sides 6,8,12,...]\n");
             return 0;
         }
-        i++;
     }
     return 1;
 }
@@ -92,6 +91,18 @@ static sl_status set_technique(sl_pipeline *p, int sides, sl_err *err)
     if (st == SL_OK)
         st = sl_params_set_numbers(&params, "caps", &caps, 1, err);
     return st == SL_OK ? sl_pipeline_set_technique(p, t, &params, err) : st;
+}
+
+/* A pipeline that owns ds (destroyed on failure too). */
+static sl_status pipeline_for(sl_gpu *gpu, sl_dataset *ds, sl_pipeline **p, sl_err *err)
+{
+    sl_status st = sl_pipeline_create(gpu, p, err);
+    if (st != SL_OK) {
+        sl_dataset_destroy(ds);
+        return st;
+    }
+    sl_pipeline_set_dataset(*p, ds);
+    return SL_OK;
 }
 
 /* ---- 1. error of one straight tube against the exact cylinder ---- */
@@ -129,14 +140,9 @@ static sl_status measure_error(sl_gpu *gpu, const options *o, int sides, error_r
     sl_dataset *ds = NULL;
     sl_status st = sl_hermite_dataset_from_json(root, "straight tube", &ds, err);
     cJSON_Delete(root);
-    if (st != SL_OK)
-        return st;
     sl_pipeline *p = NULL;
-    if ((st = sl_pipeline_create(gpu, &p, err)) != SL_OK) {
-        sl_dataset_destroy(ds);
+    if (st != SL_OK || (st = pipeline_for(gpu, ds, &p, err)) != SL_OK)
         return st;
-    }
-    sl_pipeline_set_dataset(p, ds);
     /* Side-on, slightly from above, the tube filling about half the width. */
     const double eye[3] = {0.1, 0.35, 2.2}, target[3] = {0.0, 0.0, 0.0}, fov = 45.0;
     sl_view view = {.width = o->width, .height = o->height, .origin = ds->origin, .background = {0, 0, 0, 1}};
@@ -210,14 +216,9 @@ static sl_status measure_time(sl_gpu *gpu, const options *o, const char *builtin
 {
     sl_dataset *ds = NULL;
     sl_status st = sl_generate_json(sl_builtin_lookup(builtin), &ds, err);
-    if (st != SL_OK)
-        return st;
     sl_pipeline *p = NULL;
-    if ((st = sl_pipeline_create(gpu, &p, err)) != SL_OK) {
-        sl_dataset_destroy(ds);
+    if (st != SL_OK || (st = pipeline_for(gpu, ds, &p, err)) != SL_OK)
         return st;
-    }
-    sl_pipeline_set_dataset(p, ds);
     double *ms = malloc((size_t)o->frames * sizeof *ms);
     if (!ms)
         st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");

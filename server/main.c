@@ -41,13 +41,6 @@ static void on_signal(int sig)
     interrupted = 1;
 }
 
-double sl_server_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
-
 static void usage(FILE *f)
 {
     fprintf(f,

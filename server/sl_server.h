@@ -8,6 +8,7 @@
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
+ *   clock.c    monotonic milliseconds, the one time source (any thread)
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
  * render thread owns every GL object. They share only the fields marked
@@ -272,6 +273,7 @@ sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
 void sl_ws_run(sl_server *srv, volatile int *interrupted);
 void sl_ws_destroy(sl_server *srv);
 
+/* clock.c */
 double sl_server_now_ms(void);
 
 #endif

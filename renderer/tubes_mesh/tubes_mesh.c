@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../core/sl_line_style.h"
+#include "../line_style/sl_line_style.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"

@@ -26,7 +26,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "core/sl_line_style.h"
+#include "line_style/sl_line_style.h"
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
 #include "image/sl_image.h"

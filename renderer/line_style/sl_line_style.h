@@ -10,8 +10,8 @@
 #ifndef SL_LINE_STYLE_H
 #define SL_LINE_STYLE_H
 
-#include "sl_colormap.h"
-#include "sl_params.h"
+#include "../core/sl_colormap.h"
+#include "../core/sl_params.h"
 
 struct sl_dataset;
 
