@@ -33,6 +33,9 @@ static const sl_param_def tubes_params[] = {
      "node tangents: auto (explicit Hermite data exactly, data tangent directions with Catmull-Rom length, else Catmull-Rom), catmull_rom, or the data's as they are", SL_INVALIDATE_PREPARED},
     {"frustum_culling", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
      "skip boxes outside the view frustum in the geometry shader", SL_INVALIDATE_FRAME},
+    {"small_box_pixels", SL_PARAM_FLOAT, 0, 65536, {64}, NULL, "px",
+     "a box whose projection spans at most this many pixels is drawn as one screen rectangle instead of its faces "
+     "(4 vertices instead of up to 12; 0: always faces, as the paper)", SL_INVALIDATE_FRAME},
     {"silhouette_only", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
      "discard every fragment (measures the silhouette cost; draws nothing)", SL_INVALIDATE_FRAME},
 };
@@ -143,6 +146,7 @@ static void set_uniforms(GLuint program, const sl_line_style *style, const sl_pa
     glUniform1f(glGetUniformLocation(program, "u_radius_scale"), style->radius_scale);
     glUniform1i(glGetUniformLocation(program, "u_data_radii"), data_radii);
     glUniform1i(glGetUniformLocation(program, "u_frustum_cull"), sl_params_bool(params, "frustum_culling"));
+    glUniform1f(glGetUniformLocation(program, "u_rect_pixels"), (float)sl_params_float(params, "small_box_pixels"));
     glUniform1i(glGetUniformLocation(program, "u_iterations"), sl_params_int(params, "iterations"));
     glUniform1i(glGetUniformLocation(program, "u_method"), sl_params_choice(params, "root_method"));
     glUniform2fv(glGetUniformLocation(program, "u_scalar_range"), 1, style->scalar_range);

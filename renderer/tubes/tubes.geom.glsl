@@ -16,6 +16,7 @@ in vec4 v_tangent_dradius[];
 in vec2 v_scalar[];
 
 uniform int u_frustum_cull;
+uniform float u_rect_pixels; // small_box_pixels: boxes spanning at most this many pixels become one rectangle
 
 flat out vec3 g_b0, g_b1, g_b2; // Bezier control points of the sub-segment (relative to origin)
 flat out vec3 g_r;              // Bezier controls of the radius
@@ -120,6 +121,33 @@ void emit_box(vec3 b0, vec3 b1, vec3 b2, vec3 r, vec3 c)
         }
         if (any(out_all) || out_near)
             return;
+    }
+    // A box that covers only a few pixels: one screen-aligned rectangle
+    // around its projection, at the depth of its nearest corner (fewer
+    // vertices and triangles than up to three faces; the fragment shader
+    // decides coverage exactly either way).
+    if (u_rect_pixels > 0.0) {
+        bool front = true;
+        vec2 lo2 = vec2(1e30), hi2 = vec2(-1e30);
+        float zmax = 0.0;
+        for (int i = 0; i < 8; i++) {
+            front = front && clip[i].w > 0.0 && clip[i].z <= clip[i].w;
+            vec3 ndc = clip[i].xyz / clip[i].w;
+            lo2 = min(lo2, ndc.xy);
+            hi2 = max(hi2, ndc.xy);
+            zmax = max(zmax, ndc.z);
+        }
+        vec2 size = (hi2 - lo2) * 0.5 * sl_viewport.xy;
+        if (front && size.x * size.y <= u_rect_pixels) {
+            const vec2 q[4] = vec2[4](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(1, 1));
+            for (int i = 0; i < 4; i++) {
+                gl_Position = vec4(mix(lo2, hi2, q[i]), zmax, 1.0);
+                g_b0 = b0; g_b1 = b1; g_b2 = b2; g_r = r; g_c = c.xz; g_cm = c.y;
+                EmitVertex();
+            }
+            EndPrimitive();
+            return;
+        }
     }
     // Faces: axis a, side s (0: lo, 1: hi). Corner index bit a = side.
     // Vertex order within a face is a strip over the two other axes.

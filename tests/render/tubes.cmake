@@ -41,6 +41,16 @@ tubes_render_test(accuracy.random_no_culling
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 5 --set params.frustum_culling=false)
 tubes_render_test(accuracy.random_close
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 6 --set camera.orbit.distance=0.6)
+# Both proxies of a box: always one screen rectangle (every box "small") and
+# always the box faces of the paper; coverage is the fragment shader's either way.
+tubes_render_test(accuracy.random_all_rectangles
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=65536)
+tubes_render_test(accuracy.random_all_faces
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=0)
+tubes_render_test(accuracy.stress_inside_rectangles
+  tubes-check --scene ${TUBES_DIR}/stress_inside.json --set params.small_box_pixels=65536)
+tubes_render_test(accuracy.stress_grazing_rectangles
+  tubes-check --scene ${TUBES_DIR}/stress_grazing.json --set params.small_box_pixels=65536)
 # Thin tubes (segment length / radius up to ~300) seen from inside the set:
 # the case where an expanded quartic g would lose the bound to cancellation.
 tubes_render_test(accuracy.random_thin_close
