@@ -63,11 +63,10 @@ static void text_printf(text *t, const char *fmt, ...)
         text_append(t, buf, (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1);
 }
 
-#define MAX_FILES 32
-
+/* An expansion in progress: the text so far and the files it pasted. */
 typedef struct expansion {
     text out;
-    const sl_embedded_file *files[MAX_FILES]; /* index = GLSL source-string number */
+    const sl_embedded_file *files[SL_SHADER_MAX_FILES]; /* index = GLSL source-string number */
     int file_count;
 } expansion;
 
@@ -78,8 +77,8 @@ static sl_status expand(expansion *x, const sl_embedded_file *f, int depth, sl_e
     for (int i = 0; i < x->file_count; i++)
         if (x->files[i] == f)
             return SL_OK; /* included once */
-    if (x->file_count >= MAX_FILES)
-        return sl_err_set(err, SL_ERR_GPU, "%s: more than %d shader files in one stage", f->path, MAX_FILES);
+    if (x->file_count >= SL_SHADER_MAX_FILES)
+        return sl_err_set(err, SL_ERR_GPU, "%s: more than %d shader files in one stage", f->path, SL_SHADER_MAX_FILES);
     int number = x->file_count;
     x->files[x->file_count++] = f;
     text_printf(&x->out, "#line 1 %d\n", number);
@@ -119,7 +118,7 @@ static sl_status expand(expansion *x, const sl_embedded_file *f, int depth, sl_e
 }
 
 /* Rewrites "N:L(c)" and "N(L)" at line starts of a Mesa/NVIDIA info log to "path:L". */
-static void map_log(const expansion *x, const char *log, text *out)
+static void map_log(const sl_shader_source *x, const char *log, text *out)
 {
     const char *p = log;
     while (*p) {
@@ -129,7 +128,7 @@ static void map_log(const expansion *x, const char *log, text *out)
         if (sscanf(p, "%d:%d%n", &file, &line, &used) == 2 ||
             sscanf(p, "%d(%d)%n", &file, &line, &used) == 2) {
             if (file >= 0 && file < x->file_count && used > 0 && (size_t)used <= n) {
-                text_printf(out, "%s:%d", x->files[file]->path, line);
+                text_printf(out, "%s:%d", x->paths[file], line);
                 text_append(out, p + used, n - (size_t)used);
                 text_append(out, "\n", 1);
                 p += n + (eol ? 1 : 0);
@@ -142,22 +141,39 @@ static void map_log(const expansion *x, const char *log, text *out)
     }
 }
 
-static sl_status compile_stage(GLenum stage, const char *path, const char *defines,
-                               GLuint *shader, sl_err *err)
+sl_status sl_shader_expand(const sl_embedded_file *file, const char *defines, sl_shader_source *out, sl_err *err)
 {
-    const sl_embedded_file *f = sl_embedded_find(path);
-    if (!f)
-        return sl_err_set(err, SL_ERR_GPU, "no embedded shader '%s' (is the file under renderer/?)", path);
+    memset(out, 0, sizeof *out);
     expansion x = {0};
     text_printf(&x.out, "#version 450 core\n%s", defines ? defines : "");
-    sl_status st = expand(&x, f, 0, err);
+    sl_status st = expand(&x, file, 0, err);
+    if (st == SL_OK && x.out.failed)
+        st = sl_err_set(err, SL_ERR_NOMEM, "out of memory expanding %s", file->path);
     if (st != SL_OK) {
         free(x.out.s);
         return st;
     }
+    out->text = x.out.s;
+    out->file_count = x.file_count;
+    for (int i = 0; i < x.file_count; i++)
+        out->paths[i] = x.files[i]->path;
+    return SL_OK;
+}
+
+void sl_shader_source_free(sl_shader_source *src)
+{
+    if (src) {
+        free(src->text);
+        memset(src, 0, sizeof *src);
+    }
+}
+
+sl_status sl_shader_compile(GLenum stage, const sl_shader_source *src, GLuint *shader, sl_err *err)
+{
+    *shader = 0;
     GLuint s = glCreateShader(stage);
-    const char *src = x.out.s;
-    glShaderSource(s, 1, &src, NULL);
+    const char *source = src->text;
+    glShaderSource(s, 1, &source, NULL);
     glCompileShader(s);
     GLint ok = 0;
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
@@ -165,16 +181,28 @@ static sl_status compile_stage(GLenum stage, const char *path, const char *defin
         char log[4096] = "";
         glGetShaderInfoLog(s, sizeof log, NULL, log);
         text mapped = {0};
-        map_log(&x, log, &mapped);
-        sl_err_set(err, SL_ERR_GPU, "compiling %s:\n%s", path, mapped.s ? mapped.s : log);
+        map_log(src, log, &mapped);
+        sl_err_set(err, SL_ERR_GPU, "compiling %s:\n%s", src->file_count ? src->paths[0] : "shader",
+                   mapped.s ? mapped.s : log);
         free(mapped.s);
         glDeleteShader(s);
-        free(x.out.s);
         return SL_ERR_GPU;
     }
-    free(x.out.s);
     *shader = s;
     return SL_OK;
+}
+
+static sl_status compile_stage(GLenum stage, const char *path, const char *defines, GLuint *shader, sl_err *err)
+{
+    const sl_embedded_file *f = sl_embedded_find(path);
+    if (!f)
+        return sl_err_set(err, SL_ERR_GPU, "no embedded shader '%s' (is the file under renderer/?)", path);
+    sl_shader_source src;
+    sl_status st = sl_shader_expand(f, defines, &src, err);
+    if (st == SL_OK)
+        st = sl_shader_compile(stage, &src, shader, err);
+    sl_shader_source_free(&src);
+    return st;
 }
 
 sl_status sl_gl_program_create(const sl_program_desc *d, GLuint *program, sl_err *err)

@@ -43,6 +43,23 @@ typedef struct sl_embedded_file {
 const sl_embedded_file *sl_embedded_find(const char *path);
 const sl_embedded_file *sl_embedded_list(int *count);
 
+/* One shader stage's source after #include expansion: "#version 450 core",
+ * the defines, then every pasted file behind a `#line 1 N` marker, where N
+ * indexes paths (paths[0] is the stage file). Includes come from the
+ * embedded files; the stage file itself may be any text (a checker can hand
+ * in a file read from disk). */
+#define SL_SHADER_MAX_FILES 32
+typedef struct sl_shader_source {
+    char *text;
+    const char *paths[SL_SHADER_MAX_FILES];
+    int file_count;
+} sl_shader_source;
+sl_status sl_shader_expand(const sl_embedded_file *file, const char *defines, sl_shader_source *out, sl_err *err);
+void sl_shader_source_free(sl_shader_source *src); /* zeroed is fine */
+/* Compiles an expanded source as `stage`; on failure err holds the info log
+ * with "N:L" rewritten to "path:L". */
+sl_status sl_shader_compile(GLenum stage, const sl_shader_source *src, GLuint *shader, sl_err *err);
+
 /* Builds a program from embedded shader files; any of the stage names may
  * be NULL (compute alone, or vertex+fragment, optionally geometry).
  * `defines` (may be NULL) is pasted after #version, e.g. "#define N 8\n".

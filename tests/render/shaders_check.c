@@ -4,7 +4,7 @@
  * Without --file: every embedded file (sl_embedded_list, renderer/ and below, *.glsl)
  * whose name ends in .vert/.tesc/.tese/.geom/.frag/.comp.glsl is compiled as
  * that stage, with its #include lines resolved against the embedded files by
- * the rules of renderer/gpu/shader.c (`#include "gpu/glsl/x.glsl"` pastes an
+ * renderer/gpu/shader.c itself (sl_shader_expand: `#include "gpu/glsl/x.glsl"` pastes an
  * embedded file once per stage, nesting up to 8, #version is ours:
  * "#version 450 core"). Every other embedded file is an include and must be
  * pulled in by at least one stage file, so no shader escapes compilation.
@@ -30,7 +30,6 @@
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
 
-#define MAX_FILES 32
 #define MAX_MACROS 8
 #define MAX_VALUES 16
 #define MAX_VARIANTS 256
@@ -57,71 +56,6 @@ static void put(buf *b, const char *s, size_t n)
 }
 
 static void puts_(buf *b, const char *s) { put(b, s, strlen(s)); }
-
-/* A stage file's source after include expansion, with the files it used. */
-typedef struct expansion {
-    buf text;
-    const char *paths[MAX_FILES];   /* index = GLSL source-string number */
-    const char *texts[MAX_FILES];
-    int count;
-} expansion;
-
-static int expand(expansion *x, const char *path, const char *text, size_t size, int depth, char *err, size_t cap)
-{
-    if (depth > 8) {
-        snprintf(err, cap, "%s: #include nested deeper than 8", path);
-        return 0;
-    }
-    for (int i = 0; i < x->count; i++)
-        if (x->texts[i] == text)
-            return 1;
-    if (x->count >= MAX_FILES) {
-        snprintf(err, cap, "%s: more than %d files in one stage", path, MAX_FILES);
-        return 0;
-    }
-    int number = x->count++;
-    x->paths[number] = path;
-    x->texts[number] = text;
-    char line_dir[64];
-    snprintf(line_dir, sizeof line_dir, "#line 1 %d\n", number);
-    puts_(&x->text, line_dir);
-    const char *p = text, *end = text + size;
-    for (int line = 1; p < end; line++) {
-        const char *eol = memchr(p, '\n', (size_t)(end - p));
-        size_t n = eol ? (size_t)(eol - p) : (size_t)(end - p);
-        const char *q = p;
-        while (q < p + n && (*q == ' ' || *q == '\t'))
-            q++;
-        size_t rest = (size_t)(p + n - q);
-        if (rest >= 8 && strncmp(q, "#include", 8) == 0) {
-            const char *a = memchr(q, '"', rest);
-            const char *b = a ? memchr(a + 1, '"', (size_t)(p + n - a - 1)) : NULL;
-            if (!a || !b || b - a - 1 >= 256) {
-                snprintf(err, cap, "%s:%d: malformed #include", path, line);
-                return 0;
-            }
-            char name[256];
-            memcpy(name, a + 1, (size_t)(b - a - 1));
-            name[b - a - 1] = '\0';
-            const sl_embedded_file *inc = sl_embedded_find(name);
-            if (!inc) {
-                snprintf(err, cap, "%s:%d: #include \"%s\": no such embedded file", path, line, name);
-                return 0;
-            }
-            if (!expand(x, inc->path, inc->text, inc->size, depth + 1, err, cap))
-                return 0;
-            snprintf(line_dir, sizeof line_dir, "#line %d %d\n", line + 1, number);
-            puts_(&x->text, line_dir);
-        } else if (rest >= 8 && strncmp(q, "#version", 8) == 0) {
-            puts_(&x->text, "\n");
-        } else {
-            put(&x->text, p, n);
-            puts_(&x->text, "\n");
-        }
-        p += n + 1;
-    }
-    return 1;
-}
 
 /* ---- variants ---- */
 
@@ -258,17 +192,15 @@ static GLenum stage_of(const char *path, const char **name)
     return 0;
 }
 
-/* Prints the info log with "N:L(c)" / "N(L)" at line starts rewritten to "path:L". */
-static void print_log(const expansion *x, const char *log)
+/* Prints a compile error's info log (already mapped to "path:L"), indented,
+ * without its first line ("compiling PATH:"). */
+static void print_log(const char *message)
 {
-    for (const char *p = log; *p;) {
+    const char *p = strchr(message, '\n');
+    for (p = p ? p + 1 : message; *p;) {
         const char *eol = strchr(p, '\n');
         size_t n = eol ? (size_t)(eol - p) : strlen(p);
-        int file = -1, line = -1, used = 0;
-        if ((sscanf(p, "%d:%d%n", &file, &line, &used) == 2 || sscanf(p, "%d(%d)%n", &file, &line, &used) == 2) &&
-            file >= 0 && file < x->count && used > 0 && (size_t)used <= n)
-            fprintf(stderr, "  %s:%d%.*s\n", x->paths[file], line, (int)(n - (size_t)used), p + used);
-        else
+        if (n)
             fprintf(stderr, "  %.*s\n", (int)n, p);
         p += n + (eol ? 1 : 0);
     }
@@ -283,27 +215,26 @@ static int check_file(const char *path, const char *text, size_t size, int *vari
         fprintf(stderr, "shaders-check: %s: not a stage file (.vert/.tesc/.tese/.geom/.frag/.comp.glsl)\n", path);
         return 1;
     }
-    expansion x = {0};
-    char err[512] = "";
-    if (!expand(&x, path, text, size, 0, err, sizeof err)) {
-        fprintf(stderr, "shaders-check: FAIL %s: %s\n", path, err);
-        free(x.text.s);
+    const sl_embedded_file file = {path, text, size};
+    sl_shader_source plain;
+    sl_err err = {0};
+    if (sl_shader_expand(&file, NULL, &plain, &err) != SL_OK) {
+        fprintf(stderr, "shaders-check: FAIL %s: %s\n", path, err.message);
         return 1;
     }
     macro macros[MAX_MACROS];
-    int mc = find_macros(x.text.s, macros);
+    int mc = find_macros(plain.text, macros);
+    sl_shader_source_free(&plain);
     int combos = 1;
     for (int i = 0; i < mc; i++)
         combos *= macros[i].ifdef_only ? 2 : macros[i].value_count;
     if (combos > MAX_VARIANTS) {
         fprintf(stderr, "shaders-check: FAIL %s: %d macro combinations (more than %d)\n", path, combos, MAX_VARIANTS);
-        free(x.text.s);
         return 1;
     }
     int failed = 0;
     for (int v = 0; v < combos; v++) {
-        buf src = {0}, label = {0};
-        puts_(&src, "#version 450 core\n");
+        buf defines = {0}, label = {0};
         for (int i = 0, rest = v; i < mc; i++) {
             int k = macros[i].ifdef_only ? 2 : macros[i].value_count, pick = rest % k;
             rest /= k;
@@ -313,34 +244,31 @@ static int check_file(const char *path, const char *text, size_t size, int *vari
             else {
                 int value = macros[i].ifdef_only ? 1 : macros[i].values[pick];
                 snprintf(def, sizeof def, "#define %s %d\n", macros[i].name, value);
-                puts_(&src, def);
+                puts_(&defines, def);
                 snprintf(def, sizeof def, "%s=%d ", macros[i].name, value);
             }
             puts_(&label, def);
         }
-        puts_(&src, x.text.s);
-        GLuint sh = glCreateShader(stage);
-        const char *s = src.s;
-        glShaderSource(sh, 1, &s, NULL);
-        glCompileShader(sh);
-        GLint ok = 0;
-        glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char log[8192] = "";
-            glGetShaderInfoLog(sh, sizeof log, NULL, log);
+        sl_shader_source src;
+        GLuint sh = 0;
+        sl_status st = sl_shader_expand(&file, defines.s, &src, &err);
+        if (st == SL_OK)
+            st = sl_shader_compile(stage, &src, &sh, &err);
+        if (st != SL_OK) {
             fprintf(stderr, "shaders-check: FAIL %s (%s shader%s%s):\n", path, stage_name, label.s ? ", " : "",
                     label.s ? label.s : "");
-            print_log(&x, log);
+            print_log(err.message);
             failed++;
         } else {
             printf("ok   %-44s %-9s %s\n", path, stage_name, label.s ? label.s : "");
         }
-        glDeleteShader(sh);
-        free(src.s);
+        if (sh)
+            glDeleteShader(sh);
+        sl_shader_source_free(&src);
+        free(defines.s);
         free(label.s);
         (*variants_done)++;
     }
-    free(x.text.s);
     return failed;
 }
 
@@ -351,13 +279,13 @@ static int included_by_a_stage(const char *path, const sl_embedded_file *files, 
         const char *stage_name;
         if (!stage_of(files[i].path, &stage_name))
             continue;
-        expansion x = {0};
-        char err[512];
+        sl_shader_source src;
+        sl_err err = {0};
         int used = 0;
-        if (expand(&x, files[i].path, files[i].text, files[i].size, 0, err, sizeof err))
-            for (int k = 1; k < x.count; k++)
-                used |= strcmp(x.paths[k], path) == 0;
-        free(x.text.s);
+        if (sl_shader_expand(&files[i], NULL, &src, &err) == SL_OK)
+            for (int k = 1; k < src.file_count; k++)
+                used |= strcmp(src.paths[k], path) == 0;
+        sl_shader_source_free(&src);
         if (used)
             return 1;
     }
