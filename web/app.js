@@ -81,6 +81,20 @@ function datasetByName(name) {
   return app.datasets.find((d) => d.name === name);
 }
 
+// Labels for parameters whose values name parts of the dataset: the
+// attribute names the catalog knows (null until a built-in was first made).
+function paramLabels() {
+  const names = datasetByName(app.state?.dataset)?.attributes;
+  return Array.isArray(names) && names.length ? { attribute: names } : {};
+}
+
+function buildParams() {
+  const t = techniqueByName(app.state?.technique);
+  if (!t) return;
+  params.build(t.params || [], paramLabels());
+  params.update(app.state.params);
+}
+
 function fillPickers() {
   const dsSel = $('dataset'), tSel = $('technique');
   dsSel.replaceChildren(...app.datasets.map((d) => {
@@ -99,9 +113,11 @@ function applyState(patch) {
   const techniqueChanged = patch.technique && patch.technique !== app.state?.technique;
   const datasetChanged = patch.dataset && patch.dataset !== app.state?.dataset;
   app.state = { ...(app.state || {}), ...patch };
-  const t = techniqueByName(app.state.technique);
-  if (t && (techniqueChanged || !params.inputs.size)) params.build(t.params || []);
-  params.update(app.state.params);
+  if (techniqueChanged || datasetChanged || !params.inputs.size) buildParams();
+  else params.update(app.state.params);
+  // A dataset just loaded (new bounds) that the catalog had not described
+  // yet: ask again, so its attribute names reach the controls.
+  if ('bounds' in patch && !Array.isArray(datasetByName(app.state.dataset)?.attributes)) conn.send({ type: 'list_datasets' });
   if (techniqueChanged || datasetChanged) fillPickers();
   // The controller's own camera is authoritative locally; it adopts only
   // cameras it did not send (scene, load_view) and new bounds.
@@ -211,6 +227,7 @@ conn.addEventListener('message', (ev) => {
     case 'datasets':
       app.datasets = msg.datasets || [];
       fillPickers();
+      buildParams();
       break;
     case 'views':
       $('views').replaceChildren(...(msg.views || []).map((v) => new Option(`${v.name} — ${v.dataset}/${v.technique}`, v.name)));

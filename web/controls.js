@@ -1,7 +1,8 @@
 // controls.js — parameter controls generated from a technique's schema
 // (sl_params_schema_json: name, type, min, max, default, choices, unit,
 // description). float/int -> slider + value with unit, bool -> checkbox,
-// enum -> select (colormaps too), vec3 -> three number fields. Descriptions
+// enum -> select (colormaps too), vec3 -> three number fields; an int whose
+// values have labels (the dataset's attribute names) -> select. Descriptions
 // become tooltips. Knows nothing about techniques by name.
 
 function fmt(v, type) {
@@ -37,8 +38,11 @@ export class ParamControls {
     this.schemaKey = '';
   }
 
-  build(schema) {
-    const key = JSON.stringify(schema.map((d) => d.name));
+  // labels: optional { paramName: [label of value 0, label of value 1, ...] }
+  // for int parameters whose values name things (the dataset's attributes);
+  // such a parameter becomes a select, with "none" for a value below 0.
+  build(schema, labels = {}) {
+    const key = JSON.stringify([schema.map((d) => d.name), labels]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     this.form.replaceChildren();
@@ -52,7 +56,16 @@ export class ParamControls {
       name.textContent = def.name;
       row.append(name);
       let entry;
-      if (def.type === 'float' || def.type === 'int') {
+      const names = labels[def.name];
+      if (def.type === 'int' && Array.isArray(names) && names.length) {
+        const sel = document.createElement('select');
+        sel.name = def.name;
+        if (def.min < 0) sel.append(new Option('none', '-1'));
+        names.forEach((label, i) => { if (i <= def.max) sel.append(new Option(label, String(i))); });
+        sel.addEventListener('change', () => this.onChange(def.name, Number(sel.value)));
+        row.append(sel);
+        entry = { def, set: (v) => { sel.value = String(v < 0 ? -1 : v); } };
+      } else if (def.type === 'float' || def.type === 'int') {
         const sc = scaleFor(def);
         const slider = document.createElement('input');
         slider.type = 'range';

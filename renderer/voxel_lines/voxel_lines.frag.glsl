@@ -132,6 +132,9 @@ void main()
     vec3 next_plane = vec3(cell) + max(vec3(step_dir), vec3(0.0));
     vec3 t_max = mix((next_plane - o) * inv, vec3(1e30), equal(step_dir, ivec3(0)));
     vec3 t_delta = mix(abs(inv), vec3(1e30), equal(step_dir, ivec3(0)));
+    // Finite 1/d for the voxel box tests (an axis-parallel ray gets a huge slope).
+    vec3 inv_b = 1.0 / mix(d, sign(d + 1e-30) * 1e-20, lessThan(abs(d), vec3(1e-20)));
+    float reach = u_radius_g + 1e-3; // a capsule stays within its voxel grown by the radius
 
     vec3 view_dir = -normalize(d);
     vec3 light = normalize(u_light_eye.x * sl_right.xyz + u_light_eye.y * sl_up.xyz - u_light_eye.z * sl_forward.xyz);
@@ -188,6 +191,11 @@ void main()
                         continue;
                     if (all(lessThanEqual(abs(c - prev), ivec3(R))))
                         continue; // already tested from the previous voxel
+                    // The ray must pass through the voxel grown by the radius.
+                    vec3 ba0 = (vec3(c) - reach - o) * inv_b, ba1 = (vec3(c) + (1.0 + reach) - o) * inv_b;
+                    vec3 bn = min(ba0, ba1), bf = max(ba0, ba1);
+                    if (max(max(bn.x, bn.y), bn.z) > min(min(min(bf.x, bf.y), bf.z), s_exit) )
+                        continue;
                     int v = vx_index(c);
                     uint count = vx_count(v);
                     if (count == 0u)
