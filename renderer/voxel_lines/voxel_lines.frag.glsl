@@ -58,7 +58,12 @@ bool capsule(vec3 o, vec3 d, vec3 a, vec3 b, float r, out float t_in, out float 
         float qb = baba * rdoa - baoa * bard;
         float qc = baba * oaoa - baoa * baoa - r * r * baba;
         float h = qb * qb - qa * qc;
-        if (h >= 0.0) {
+        if (h < 0.0) {
+            // Misses the infinite cylinder, which holds the capsule (unless
+            // nearly parallel, where h is too inexact to trust).
+            if (qa > 1e-3 * baba * dd)
+                return false;
+        } else {
             h = sqrt(h);
             float t0 = (-qb - h) / qa, t1 = (-qb + h) / qa;
             float y0 = baoa + t0 * bard, y1 = baoa + t1 * bard;

@@ -153,6 +153,12 @@ async function main() {
     }
     await page.screenshot({ path: path.join(artifacts, 'browser-test-controller.png') });
 
+    // 3a. The attribute parameter names the dataset's attributes once it is loaded.
+    await page.waitForFunction(() => document.querySelectorAll('#params select[name=attribute] option').length > 1,
+      null, { timeout: T }).catch(() => {});
+    const attrs = await page.$$eval('#params select[name=attribute] option', (os) => os.map((o) => o.textContent));
+    check(attrs[0] === 'none' && attrs.length > 1, `attribute control lists the dataset's attributes ${JSON.stringify(attrs)}`);
+
     // 3b. Snapshot button downloads a PNG; a named view is saved and listed.
     const [download] = await Promise.all([page.waitForEvent('download', { timeout: T }), page.click('#snapshot')]);
     const snapPath = path.join(dir, 'snapshot.png');
