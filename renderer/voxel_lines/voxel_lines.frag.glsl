@@ -11,6 +11,12 @@
 // since its voxel is within R of that one (radius <= R voxels). Hits of one
 // curve (same local id) whose intervals overlap are one tube (the joint
 // spheres), blended once.
+// Speed (llvmpipe runs 8 pixels in SIMD lanes whose rays visit different
+// voxels): a voxel whose box grown by the radius the ray misses is skipped
+// without reading its lines; the lines of all voxels to test at a step are
+// walked in one flat loop (a bit mask of voxels), so a lane does not idle
+// while another works through a full voxel; a line record is read with three
+// word loads; a ray missing a line's infinite cylinder skips its end spheres.
 // Opaque (u_opacity >= 1): the first hit ends the ray. Writes premultiplied
 // colour for blending (ONE, ONE_MINUS_SRC_ALPHA) and reversed-Z depth of the
 // first composited hit.
@@ -42,7 +48,7 @@ layout(location = 0) out vec4 o_color;
 #define MAX_HITS 16
 float h_in[MAX_HITS], h_out[MAX_HITS];
 vec3 h_n[MAX_HITS];
-uint h_attr[MAX_HITS], h_id[MAX_HITS];
+uint h_key[MAX_HITS]; // attribute byte << 8 | local id
 int h_count;
 
 // Entry/exit of ray o + s d with the capsule a-b of radius r; false when missed.
@@ -59,9 +65,12 @@ bool capsule(vec3 o, vec3 d, vec3 a, vec3 b, float r, out float t_in, out float 
         float qc = baba * oaoa - baoa * baoa - r * r * baba;
         float h = qb * qb - qa * qc;
         if (h < 0.0) {
-            // Misses the infinite cylinder, which holds the capsule (unless
-            // nearly parallel, where h is too inexact to trust).
-            if (qa > 1e-3 * baba * dd)
+            // Misses the infinite cylinder, which holds the capsule, so the
+            // end spheres are missed too. Only when clearly negative: h is a
+            // difference of large terms (the eye is far away); its rounding
+            // error is ~1e-7 qb^2 / sin^2 of the ray-line angle, and when it is
+            // not clearly negative the sphere tests decide as before.
+            if (h < -1e-3 * qb * qb)
                 return false;
         } else {
             h = sqrt(h);
@@ -107,15 +116,13 @@ void add_hit(float tin, float tout, vec3 n, uint attr, uint id)
         h_in[i] = h_in[i - 1];
         h_out[i] = h_out[i - 1];
         h_n[i] = h_n[i - 1];
-        h_attr[i] = h_attr[i - 1];
-        h_id[i] = h_id[i - 1];
+        h_key[i] = h_key[i - 1];
         i--;
     }
     h_in[i] = tin;
     h_out[i] = tout;
     h_n[i] = n;
-    h_attr[i] = attr;
-    h_id[i] = id;
+    h_key[i] = attr << 8u | id;
 }
 
 void main()
@@ -159,6 +166,7 @@ void main()
     int steps = u_dims.x + u_dims.y + u_dims.z + 3;
     int R = u_neighbors;
     ivec3 prev = ivec3(-1000000);
+    int step_axis = 0;
     h_count = 0;
     for (int it = 0; it < steps; it++) {
         if (u_skip_levels >= 0 && texelFetch(u_occupancy, cell, 0).r == 0u) {
@@ -188,38 +196,62 @@ void main()
             continue;
         }
         float s_leave = min(min(t_max.x, t_max.y), min(t_max.z, s_exit));
-        for (int dz = -R; dz <= R; dz++)
-            for (int dy = -R; dy <= R; dy++)
-                for (int dx = -R; dx <= R; dx++) {
-                    ivec3 c = cell + ivec3(dx, dy, dz);
+        // The voxels of the (2R+1)^3 block not tested from the previous voxel:
+        // after a DDA step the slab on the stepped axis's far side, else
+        // (first voxel, after a skip, or R = 0) the whole block as 2R+1 slabs
+        // along z. Per slab a bit mask of the voxels that hold lines and that
+        // the ray crosses when grown by the radius, then one flat loop over
+        // their lines (so that SIMD lanes with different voxels stay busy).
+        bool fresh = prev.x == -1000000;
+        int W = 2 * R + 1;
+        int slabs = fresh ? W : 1;
+        for (int sl = 0; sl < slabs; sl++) {
+            int ax = fresh ? 2 : step_axis;
+            int off = fresh ? sl - R : R * step_dir[step_axis];
+            uint mask = 0u;
+            int j = 0;
+            for (int dv = -R; dv <= R; dv++)
+                for (int du = -R; du <= R; du++, j++) {
+                    ivec3 c = cell + (ax == 0 ? ivec3(off, du, dv) : (ax == 1 ? ivec3(du, off, dv) : ivec3(du, dv, off)));
                     if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, u_dims)))
                         continue;
-                    if (all(lessThanEqual(abs(c - prev), ivec3(R))))
-                        continue; // already tested from the previous voxel
                     // The ray must pass through the voxel grown by the radius.
                     vec3 ba0 = (vec3(c) - reach - o) * inv_b, ba1 = (vec3(c) + (1.0 + reach) - o) * inv_b;
                     vec3 bn = min(ba0, ba1), bf = max(ba0, ba1);
-                    if (max(max(bn.x, bn.y), bn.z) > min(min(min(bf.x, bf.y), bf.z), s_exit) )
+                    if (max(max(bn.x, bn.y), bn.z) > min(min(min(bf.x, bf.y), bf.z), s_exit))
                         continue;
-                    int v = vx_index(c);
-                    uint count = vx_count(v);
-                    if (count == 0u)
-                        continue;
-                    uint first = vx_offsets[v];
-                    vec3 corner = vec3(c);
-                    for (uint l = 0u; l < count; l++) {
-                        vec3 a, b;
-                        uint attr, id;
-                        vx_line(first + l, a, b, attr, id);
-                        float tin, tout;
-                        vec3 n;
-                        if (!capsule(o, d, corner + a, corner + b, u_radius_g, tin, tout, n))
-                            continue;
-                        if (tout < s_near)
-                            continue;
-                        add_hit(max(tin, s_near), tout, n, attr, id);
-                    }
+                    if (vx_count(vx_index(c)) != 0u)
+                        mask |= 1u << uint(j);
                 }
+            uint l = 0u, count = 0u, first = 0u;
+            vec3 corner = vec3(0.0);
+            while (mask != 0u || l < count) {
+                if (l >= count) {
+                    int jb = findLSB(mask);
+                    mask &= mask - 1u;
+                    int jv = W == 5 ? (jb * 13) >> 6 : (jb * 11) >> 5; // jb / W for W = 1, 3, 5
+                    int ju = jb - W * jv - R;
+                    jv -= R;
+                    ivec3 c = cell + (ax == 0 ? ivec3(off, ju, jv) : (ax == 1 ? ivec3(ju, off, jv) : ivec3(ju, jv, off)));
+                    int v = vx_index(c);
+                    count = vx_count(v);
+                    first = vx_offsets[v];
+                    corner = vec3(c);
+                    l = 0u;
+                }
+                vec3 a, b;
+                uint attr, id;
+                vx_line(first + l, a, b, attr, id);
+                l++;
+                float tin, tout;
+                vec3 n;
+                if (!capsule(o, d, corner + a, corner + b, u_radius_g, tin, tout, n))
+                    continue;
+                if (tout < s_near)
+                    continue;
+                add_hit(max(tin, s_near), tout, n, attr, id);
+            }
+        }
         prev = R > 0 ? cell : ivec3(-1000000);
         // Pending hits that start before this voxel's exit are final: every
         // capsule entering there belongs to a voxel adjacent to one visited.
@@ -228,18 +260,19 @@ void main()
             if (R > 0 && h_in[i] >= s_leave)
                 break;
             used++;
+            uint hid = h_key[i] & 255u;
             bool merged = false;
             for (int j = 0; j < 8; j++)
-                if (last_id[j] == h_id[i] && h_in[i] <= last_out[j] + 1e-4 * h_in[i]) {
+                if (last_id[j] == hid && h_in[i] <= last_out[j] + 1e-4 * h_in[i]) {
                     last_out[j] = max(last_out[j], h_out[i]);
                     merged = true;
                 }
             if (merged)
                 continue;
-            last_id[last_next] = h_id[i];
+            last_id[last_next] = hid;
             last_out[last_next] = h_out[i];
             last_next = (last_next + 1) & 7;
-            float t = mix(u_attr_range.x, u_attr_range.y, float(h_attr[i]) / 255.0);
+            float t = mix(u_attr_range.x, u_attr_range.y, float(h_key[i] >> 8u) / 255.0);
             vec3 base = u_use_colormap != 0 ? sl_colormap(u_colormap, t, vec2(0.0, 1.0)) : u_color;
             vec3 pos_g = o + h_in[i] * d;
             vec3 n = normalize(h_n[i]);
@@ -261,8 +294,7 @@ void main()
             h_in[i - used] = h_in[i];
             h_out[i - used] = h_out[i];
             h_n[i - used] = h_n[i];
-            h_attr[i - used] = h_attr[i];
-            h_id[i - used] = h_id[i];
+            h_key[i - used] = h_key[i];
         }
         h_count -= used;
         if (alpha >= u_alpha_stop || s_leave >= s_exit)
@@ -271,12 +303,15 @@ void main()
         if (t_max.x <= t_max.y && t_max.x <= t_max.z) {
             cell.x += step_dir.x;
             t_max.x += t_delta.x;
+            step_axis = 0;
         } else if (t_max.y <= t_max.z) {
             cell.y += step_dir.y;
             t_max.y += t_delta.y;
+            step_axis = 1;
         } else {
             cell.z += step_dir.z;
             t_max.z += t_delta.z;
+            step_axis = 2;
         }
         if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, u_dims)))
             break;

@@ -17,37 +17,40 @@ int vx_index(ivec3 c) { return c.x + u_dims.x * (c.y + u_dims.y * c.z); }
 
 uint vx_count(int v) { return (vx_counts[v >> 2] >> uint((v & 3) * 8)) & 255u; }
 
-// n < 32 bits starting at bit pos; a field spans at most two words.
-uint vx_bits(uint pos, uint n)
+// Bits [p, p + n) of the 64-bit value hi:lo (n < 32; a shift by 32 is
+// written as two shifts, since GLSL leaves it undefined).
+uint vx_field(uint lo, uint hi, uint p, uint n)
 {
-    uint w = pos >> 5u, o = pos & 31u;
-    uint v = vx_words[w] >> o;
-    if (o + n > 32u)
-        v |= vx_words[w + 1u] << (32u - o);
+    uint v = p >= 32u ? hi >> (p - 32u) : (lo >> p) | ((hi << 1u) << (31u - p));
     return v & ((1u << n) - 1u);
 }
 
+// Endpoint on face `face` (axis = face / 2, side = face & 1) at bin `bin`
+// (s + N t) of the N x N subdivision: bin centres, exact since N = 2^k.
 vec3 vx_dequantize(uint face, uint bin)
 {
-    int axis = int(face >> 1u);
-    int s = axis == 0 ? 1 : 0;
-    int t = axis == 2 ? 1 : 2;
-    uint n = uint(u_quant);
-    vec3 u;
-    u[axis] = float(face & 1u);
-    u[s] = (float(bin % n) + 0.5) / float(n);
-    u[t] = (float(bin / n) + 0.5) / float(n);
-    return u;
+    uint k = uint(u_quant_bits);
+    float inv_n = 1.0 / float(u_quant);
+    vec2 st = (vec2(float(bin & ((1u << k) - 1u)), float(bin >> k)) + 0.5) * inv_n;
+    float side = float(face & 1u);
+    uint axis = face >> 1u;
+    return axis == 0u ? vec3(side, st.x, st.y) : (axis == 1u ? vec3(st.x, side, st.y) : vec3(st.x, st.y, side));
 }
 
-// Line `index`: endpoints relative to its voxel's corner, attribute byte and id.
+// Line `index`: endpoints relative to its voxel's corner, attribute byte and
+// id. A record (<= 56 bits, byte aligned) lies in three consecutive words
+// (the line buffer has 8 zero bytes of padding after the last record).
 void vx_line(uint index, out vec3 a, out vec3 b, out uint attr, out uint id)
 {
     uint pos = index * uint(u_line_bits);
+    uint w = pos >> 5u, o = pos & 31u;
+    uint w0 = vx_words[w], w1 = vx_words[w + 1u], w2 = vx_words[w + 2u];
+    uint lo = (w0 >> o) | ((w1 << 1u) << (31u - o));
+    uint hi = (w1 >> o) | ((w2 << 1u) << (31u - o));
     uint k2 = uint(2 * u_quant_bits);
     uint eb = 3u + k2;
-    a = vx_dequantize(vx_bits(pos, 3u), vx_bits(pos + 3u, k2));
-    b = vx_dequantize(vx_bits(pos + eb, 3u), vx_bits(pos + eb + 3u, k2));
-    attr = vx_bits(pos + 2u * eb, 8u);
-    id = vx_bits(pos + 2u * eb + 8u, 5u);
+    a = vx_dequantize(lo & 7u, vx_field(lo, hi, 3u, k2));
+    b = vx_dequantize(vx_field(lo, hi, eb, 3u), vx_field(lo, hi, eb + 3u, k2));
+    attr = vx_field(lo, hi, 2u * eb, 8u);
+    id = vx_field(lo, hi, 2u * eb + 8u, 5u);
 }
