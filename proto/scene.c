@@ -87,8 +87,14 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
         return sl_err_set(err, SL_ERR_INVALID, "camera.fov_y must be in (0, 180) degrees, got %g", fov);
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(obj, "orbit");
     if (o) {
-        if (cJSON_GetObjectItemCaseSensitive(obj, "eye") || cJSON_GetObjectItemCaseSensitive(obj, "target"))
-            return sl_err_set(err, SL_ERR_INVALID, "camera: give either orbit or eye/target, not both");
+        /* The two forms first: an orbit beside eye/target is a mix of two
+         * cameras, whatever else is wrong with either. */
+        int has_eye = cJSON_GetObjectItemCaseSensitive(obj, "eye") != NULL;
+        int has_target = cJSON_GetObjectItemCaseSensitive(obj, "target") != NULL;
+        if (has_eye || has_target)
+            return sl_err_set(err, SL_ERR_INVALID,
+                              "camera: give either orbit or eye/target/up, not both (this camera has orbit and %s)",
+                              has_eye && has_target ? "eye, target" : has_eye ? "eye" : "target");
         if (cJSON_GetObjectItemCaseSensitive(obj, "up"))
             return sl_err_set(err, SL_ERR_INVALID, "camera.up: an orbit camera's up is always +y (use eye/target/up for another)");
         if (!cJSON_IsObject(o))
@@ -102,6 +108,9 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
             return st;
         if (!(r.distance > 0.0))
             return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.distance must be > 0, got %g", r.distance);
+        if (fabs(r.elevation_deg) > SL_ORBIT_MAX_ELEVATION)
+            return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.elevation must be in [%g, %g] degrees, got %g",
+                              -SL_ORBIT_MAX_ELEVATION, SL_ORBIT_MAX_ELEVATION, r.elevation_deg);
         *orbit = r;
         *is_orbit = 1;
         return SL_OK;
@@ -196,6 +205,9 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
         if (!cJSON_IsNumber(of) || of->valuedouble != floor(of->valuedouble) || of->valuedouble < 0 || of->valuedouble > 1e6)
             return sl_err_set(err, SL_ERR_INVALID, "orbit_frames must be an integer in [0, 1000000]");
         s->orbit_frames = (int)of->valuedouble;
+        if (s->orbit_frames > 0 && !s->camera_is_orbit)
+            return sl_err_set(err, SL_ERR_INVALID, "orbit_frames turns an orbit camera, but this camera is "
+                                                   "eye/target/up (use camera.orbit, or remove orbit_frames)");
     }
     s->dataset = cJSON_Duplicate(ds, 1);
     s->params = params ? cJSON_Duplicate(params, 1) : NULL;
@@ -229,6 +241,13 @@ sl_status sl_scene_parse(const char *json_text, sl_scene *scene, sl_err *err)
     return st;
 }
 
+static void drop_eye_target_up(cJSON *camera)
+{
+    cJSON_DeleteItemFromObjectCaseSensitive(camera, "eye");
+    cJSON_DeleteItemFromObjectCaseSensitive(camera, "target");
+    cJSON_DeleteItemFromObjectCaseSensitive(camera, "up");
+}
+
 sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *err)
 {
     const char *eq = strchr(assignment, '=');
@@ -256,11 +275,11 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
                 cJSON_ReplaceItemInObjectCaseSensitive(node, part, value);
             else
                 cJSON_AddItemToObject(node, part, value);
-            /* Orbit and eye/target are alternatives: setting one drops the other. */
+            /* Orbit and eye/target/up are alternatives: setting one drops the
+             * other (up belongs to eye/target; an orbit's up is always +y). */
             if (node != root && cJSON_GetObjectItemCaseSensitive(root, "camera") == node) {
                 if (strcmp(part, "orbit") == 0) {
-                    cJSON_DeleteItemFromObjectCaseSensitive(node, "eye");
-                    cJSON_DeleteItemFromObjectCaseSensitive(node, "target");
+                    drop_eye_target_up(node);
                 } else if (strcmp(part, "eye") == 0 || strcmp(part, "target") == 0) {
                     cJSON_DeleteItemFromObjectCaseSensitive(node, "orbit");
                 }
@@ -274,10 +293,8 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
             cJSON_Delete(value);
             return sl_err_set(err, SL_ERR_INVALID, "--set %s: '%s' is not an object", key, part);
         }
-        if (node == cJSON_GetObjectItemCaseSensitive(root, "camera") && strcmp(part, "orbit") == 0) {
-            cJSON_DeleteItemFromObjectCaseSensitive(node, "eye");
-            cJSON_DeleteItemFromObjectCaseSensitive(node, "target");
-        }
+        if (node == cJSON_GetObjectItemCaseSensitive(root, "camera") && strcmp(part, "orbit") == 0)
+            drop_eye_target_up(node);
         node = child;
         part = next;
     }

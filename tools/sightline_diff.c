@@ -5,6 +5,12 @@
  * sl_diff.h and the verdict against the limits given; optionally writes a heat
  * map PNG. The metrics themselves live in renderer/image/diff.c; this file only
  * parses arguments, reads files and formats JSON. Single-threaded.
+ * Depth maps: bad_pct counts every coverage mismatch (hit in one map, missed
+ * in the other) as a bad pixel, over the pixels either map hits; mean and max
+ * are over pixels both hit. When any limit is given for a depth pair and
+ * --max-coverage-pct is not, coverage must match exactly (an implicit
+ * --max-coverage-pct 0), so "--max-mean 0" cannot pass two maps that hit
+ * different pixels.
  * Exit status: 0 within all limits, 1 when a limit is exceeded, 2 on bad usage
  * or bad input (unreadable file, mixed kinds, size mismatch), with the reason
  * on stderr and nothing on stdout.
@@ -40,7 +46,13 @@ static void usage(FILE *f)
             "usage: sightline-diff A B [--diff heat.png] [--bad-threshold T]\n"
             "                      [--max-mean X] [--max-bad-pct Y] [--max-coverage-pct Z] [--max-abs M]\n"
             "A and B: both PNG (colour, 0..255 units) or both PFM (depth, world units; 0 = no hit).\n"
-            "--bad-threshold defaults to 8 (colour) or 1e-3 (depth); --max-coverage-pct applies to depth only.\n"
+            "  mean_abs, max_abs, psnr_db: colour over all pixels; depth over pixels hit in both maps.\n"
+            "  bad_pct: %% of compared pixels that are bad: difference > T; for depth, compared = pixels\n"
+            "    hit in either map and every coverage mismatch (hit in one, missed in the other) is bad.\n"
+            "  coverage_mismatch_pct (depth): %% of the pixels hit in either map that only one hits.\n"
+            "--bad-threshold T defaults to 8 (colour) or 1e-3 (depth).\n"
+            "--max-coverage-pct applies to depth only; when a depth pair is given any other limit\n"
+            "  and not this one, coverage must match exactly (--max-coverage-pct 0).\n"
             "Prints JSON; exit 0 = within limits, 1 = a limit exceeded, 2 = bad input.\n");
 }
 
@@ -164,6 +176,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "sightline-diff: note: --max-coverage-pct applies to depth maps only; ignored for PNG\n");
     if (!threshold_set)
         threshold = depth ? 1e-3 : 8.0;
+    /* A depth limit without a coverage limit must not pass maps that hit
+     * different pixels: mean and max only see pixels both maps hit. */
+    int coverage_implicit = 0;
+    if (depth && !limits[LIM_COVERAGE_PCT].set &&
+        (limits[LIM_MEAN].set || limits[LIM_BAD_PCT].set || limits[LIM_ABS].set)) {
+        limits[LIM_COVERAGE_PCT].set = 1;
+        limits[LIM_COVERAGE_PCT].value = 0.0;
+        coverage_implicit = 1;
+    }
 
     sl_err err = {0};
     sl_status st = SL_OK;
@@ -208,6 +229,7 @@ int main(int argc, char **argv)
     cJSON_AddNumberToObject(json, "bad_count", (double)r.bad_count);
     cJSON_AddNumberToObject(json, "compared", (double)r.compared);
     if (depth) {
+        cJSON_AddNumberToObject(json, "both_hit", (double)r.both_hit);
         cJSON_AddNumberToObject(json, "coverage_mismatch", (double)r.coverage_mismatch);
         add_number(json, "coverage_mismatch_pct", r.coverage_mismatch_pct);
     }
@@ -229,6 +251,8 @@ int main(int argc, char **argv)
         if (measured[k] > limits[k].value)
             cJSON_AddItemToArray(failed, cJSON_CreateString(limits[k].name));
     }
+    if (coverage_implicit)
+        cJSON_AddBoolToObject(lims, "max_coverage_pct_implicit", 1);
     int pass = cJSON_GetArraySize(failed) == 0;
     cJSON_AddBoolToObject(json, "pass", pass);
     cJSON_AddItemToObject(json, "failed", failed);

@@ -6,13 +6,27 @@
  * A thin main over the renderer library: scene -> dataset -> pipeline. The
  * colour frame uses --samples MSAA (default 4); the depth map is rendered
  * without MSAA so every pixel is the exact centre ray of sl_camera.h.
- * Exit codes: 0 ok, 1 usage, 2 bad input (scene, dataset), 3 GPU failure.
+ * Everything that can be checked before the (possibly long) render is: the
+ * arguments, the output paths (known extension, writable: see
+ * check_output), the scene, and the GPU's limits
+ * for the target size and --samples. It does not retry or fall back.
+ * Exit codes (also in --help): 0 ok; 1 usage (bad or missing arguments);
+ * 2 bad input (scene, dataset, parameters, output paths, a write that
+ * failed, out of memory); 3 GPU (no EGL display or 4.5 context, a bad
+ * SIGHTLINE_EGL_DEVICE, a request above the GPU's limits such as --samples,
+ * a GL failure). Single-threaded (the render thread is the main thread).
  */
 #include <cjson/cJSON.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <libgen.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "data/sl_load.h"
 #include "image/sl_image.h"
@@ -22,56 +36,175 @@
 
 #define MAX_SETS 64
 
+#define EXIT_OK 0
+#define EXIT_USAGE 1
+#define EXIT_BAD_INPUT 2
+#define EXIT_GPU 3
+
 typedef struct options {
     const char *scene, *out, *depth, *stats, *data_dir;
     const char *sets[MAX_SETS];
     int set_count, frames, samples;
 } options;
 
-static int usage(const char *msg)
+static void print_usage(FILE *f)
 {
-    if (msg)
-        fprintf(stderr, "sightline-render: %s\n", msg);
-    fprintf(stderr, "usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm] [--frames N]\n"
-                    "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR]\n");
+    fprintf(f, "usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm] [--frames N]\n"
+               "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR]\n"
+               "  --out      .png, or .jpg/.jpeg for JPEG     --depth  .pfm (eye distance, 0 = no hit)\n"
+               "  --stats    .json                            --frames N in [1, 100000] (default 1)\n"
+               "  --samples  MSAA samples in [0, 16] (default 4; 0 or 1 = none; at most what the GPU offers)\n"
+               "  --data-dir where relative dataset paths are looked up (default: the scene's folder)\n"
+               "exit: 0 ok, 1 usage, 2 bad input (scene, dataset, parameters, output paths, write failed),\n"
+               "      3 GPU (no EGL display or 4.5 context, bad SIGHTLINE_EGL_DEVICE, above a GPU limit such\n"
+               "      as --samples, GL failure)\n");
+}
+
+static int usage(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int usage(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "sightline-render: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n");
+    va_end(ap);
+    print_usage(stderr);
+    return EXIT_USAGE;
+}
+
+/* Strict decimal integer in [lo, hi]: the whole text, no sign tricks. */
+static int parse_int(const char *text, int lo, int hi, int *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi || text[0] == ' ' || text[0] == '+')
+        return 0;
+    *out = (int)v;
     return 1;
 }
 
+/* Returns 0 to go on, -1 after --help, else the exit code. */
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->frames = 1;
     o->samples = 4;
-    for (int i = 1; i < argc; i += 2) {
+    for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0)
-            return usage(NULL), -1;
-        if (!v)
-            return usage("missing value after an option");
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_usage(stdout);
+            return -1;
+        }
+        if (strncmp(a, "--", 2) != 0)
+            return usage("unexpected argument '%s' (every value follows its option, e.g. --scene S.json)", a);
+        static const char *const known[] = {"--scene", "--out", "--depth", "--stats", "--data-dir",
+                                            "--frames", "--samples", "--set", NULL};
+        int k = 0;
+        while (known[k] && strcmp(a, known[k]) != 0)
+            k++;
+        if (!known[k])
+            return usage("unknown option '%s'", a);
+        if (i + 1 >= argc)
+            return usage("%s needs a value", a);
+        const char *v = argv[++i];
         if (strcmp(a, "--scene") == 0) o->scene = v;
         else if (strcmp(a, "--out") == 0) o->out = v;
         else if (strcmp(a, "--depth") == 0) o->depth = v;
         else if (strcmp(a, "--stats") == 0) o->stats = v;
         else if (strcmp(a, "--data-dir") == 0) o->data_dir = v;
         else if (strcmp(a, "--frames") == 0) {
-            o->frames = atoi(v);
-            if (o->frames < 1 || o->frames > 100000)
-                return usage("--frames must be in [1, 100000]");
+            if (!parse_int(v, 1, 100000, &o->frames))
+                return usage("--frames must be an integer in [1, 100000], got '%s'", v);
         } else if (strcmp(a, "--samples") == 0) {
-            o->samples = atoi(v);
-            if (o->samples < 0 || o->samples > 16)
-                return usage("--samples must be in [0, 16]");
-        } else if (strcmp(a, "--set") == 0) {
+            if (!parse_int(v, 0, 16, &o->samples))
+                return usage("--samples must be an integer in [0, 16], got '%s'", v);
+        } else {
             if (o->set_count >= MAX_SETS)
-                return usage("too many --set options");
+                return usage("too many --set options (at most %d)", MAX_SETS);
             o->sets[o->set_count++] = v;
-        } else
-            return usage("unknown option");
+        }
     }
     if (!o->scene || !o->out)
         return usage("--scene and --out are required");
     return 0;
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
+
+/* An output path must end in one of exts (NULL-terminated), not be a
+ * folder, and be writable: an existing file is opened for writing (not
+ * truncated); a new one is created and removed again, which also holds for
+ * root, whom access() does not refuse, and for read-only or special file
+ * systems. Checked before rendering so that a bad path does not cost a
+ * render. Prints the reason and returns 0 when not. */
+static int check_output(const char *option, const char *path, const char *const *exts)
+{
+    int known = 0;
+    char list[64] = "";
+    for (int k = 0; exts[k]; k++) {
+        known |= ends_with(path, exts[k]);
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "", exts[k]);
+    }
+    if (!known) {
+        fprintf(stderr, "sightline-render: %s %s: unknown extension (expected %s)\n", option, path, list);
+        return 0;
+    }
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if (S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "sightline-render: %s %s: is a folder\n", option, path);
+            return 0;
+        }
+        int fd = open(path, O_WRONLY);
+        if (fd < 0) {
+            fprintf(stderr, "sightline-render: %s %s: not writable: %s\n", option, path, strerror(errno));
+            return 0;
+        }
+        close(fd);
+        return 1;
+    }
+    char copy[4096];
+    if (strlen(path) >= sizeof copy) {
+        fprintf(stderr, "sightline-render: %s: path longer than %zu bytes\n", option, sizeof copy - 1);
+        return 0;
+    }
+    snprintf(copy, sizeof copy, "%s", path);
+    const char *dir = dirname(copy);
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "sightline-render: %s %s: folder %s does not exist\n", option, path, dir);
+        return 0;
+    }
+    int fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0666);
+    if (fd < 0) {
+        fprintf(stderr, "sightline-render: %s %s: cannot create it in %s: %s\n", option, path, dir, strerror(errno));
+        return 0;
+    }
+    close(fd);
+    unlink(path);
+    return 1;
+}
+
+static int check_outputs(const options *o)
+{
+    static const char *const image_exts[] = {".png", ".jpg", ".jpeg", NULL};
+    static const char *const depth_exts[] = {".pfm", NULL};
+    static const char *const stats_exts[] = {".json", NULL};
+    /* The extension sets are disjoint, so no two outputs can name the same file. */
+    return check_output("--out", o->out, image_exts) && (!o->depth || check_output("--depth", o->depth, depth_exts)) &&
+           (!o->stats || check_output("--stats", o->stats, stats_exts));
+}
+
+/* Exit code of a pipeline (GPU-side) failure: the GPU's (3: GL failure, or
+ * a request beyond this GPU's limits) or the input's (2). */
+static int exit_for(sl_status st)
+{
+    return st == SL_ERR_GPU || st == SL_ERR_UNSUPPORTED ? EXIT_GPU : EXIT_BAD_INPUT;
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -90,10 +223,87 @@ static cJSON *summary(double *v, int n)
     return o;
 }
 
-static int ends_with(const char *s, const char *suffix)
+/* 1 when the document's camera is in the orbit form, 0 when eye/target, -1 without a camera. */
+static int camera_form(const cJSON *root)
 {
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (!cJSON_IsObject(cam))
+        return -1;
+    if (cJSON_GetObjectItemCaseSensitive(cam, "orbit"))
+        return 1;
+    return cJSON_GetObjectItemCaseSensitive(cam, "eye") || cJSON_GetObjectItemCaseSensitive(cam, "target") ? 0 : -1;
+}
+
+/* Reads and parses the scene with the overrides applied; prints the reason. */
+static int load_scene(const options *o, sl_scene *scene)
+{
+    sl_err err = {0};
+    uint8_t *text = NULL;
+    size_t text_size = 0;
+    if (sl_read_file(o->scene, 16u << 20, &text, &text_size, &err) != SL_OK) {
+        fprintf(stderr, "sightline-render: %s\n", err.message);
+        return 0;
+    }
+    cJSON *root = cJSON_ParseWithLength((const char *)text, text_size);
+    free(text);
+    if (!root) {
+        fprintf(stderr, "sightline-render: %s is not valid JSON\n", o->scene);
+        return 0;
+    }
+    for (int i = 0; i < o->set_count; i++) {
+        int before = camera_form(root);
+        if (sl_scene_apply_override(root, o->sets[i], &err) != SL_OK) {
+            fprintf(stderr, "sightline-render: %s\n", err.message);
+            cJSON_Delete(root);
+            return 0;
+        }
+        int after = camera_form(root);
+        if (before == 0 && after == 1)
+            fprintf(stderr, "sightline-render: note: --set %s replaces the scene's eye/target/up camera with an orbit "
+                            "(orbit fields not set take their defaults)\n", o->sets[i]);
+        else if (before == 1 && after == 0)
+            fprintf(stderr, "sightline-render: note: --set %s replaces the scene's orbit camera with eye/target/up\n",
+                    o->sets[i]);
+    }
+    sl_status st = sl_scene_from_json(root, scene, &err);
+    cJSON_Delete(root);
+    if (st != SL_OK) {
+        fprintf(stderr, "sightline-render: %s: %s\n", o->scene, err.message);
+        return 0;
+    }
+    return 1;
+}
+
+static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gpu, const sl_technique *tech,
+                       double *gpu_ms, double *wall_ms, double load_ms, const sl_frame_stats *first,
+                       const sl_frame_stats *last)
+{
+    cJSON *s = cJSON_CreateObject();
+    cJSON_AddStringToObject(s, "renderer", sl_gpu_renderer(gpu));
+    cJSON_AddStringToObject(s, "technique", tech->name);
+    cJSON_AddNumberToObject(s, "width", scene->width);
+    cJSON_AddNumberToObject(s, "height", scene->height);
+    cJSON_AddNumberToObject(s, "frames", o->frames);
+    cJSON_AddNumberToObject(s, "samples", o->samples);
+    cJSON_AddItemToObject(s, "gpu_ms", summary(gpu_ms, o->frames));
+    cJSON_AddItemToObject(s, "wall_ms", summary(wall_ms, o->frames));
+    cJSON_AddNumberToObject(s, "dataset_load_ms", load_ms);
+    cJSON_AddNumberToObject(s, "prepare_ms", first->prepare_ms);
+    cJSON_AddNumberToObject(s, "gpu_bytes", (double)last->gpu_bytes);
+    cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
+    cJSON_AddNumberToObject(s, "culled", last->render.culled);
+    char *out = cJSON_Print(s);
+    cJSON_Delete(s);
+    errno = 0;
+    FILE *f = out ? fopen(o->stats, "w") : NULL;
+    int ok = f && fputs(out, f) >= 0 && fputc('\n', f) != EOF;
+    if (f && fclose(f) != 0)
+        ok = 0;
+    if (!ok)
+        fprintf(stderr, "sightline-render: cannot write %s%s%s\n", o->stats, errno ? ": " : "",
+                errno ? strerror(errno) : "");
+    free(out);
+    return ok;
 }
 
 int main(int argc, char **argv)
@@ -101,39 +311,27 @@ int main(int argc, char **argv)
     options o;
     int rc = parse_args(argc, argv, &o);
     if (rc != 0)
-        return rc < 0 ? 0 : 1;
-
-    sl_err err = {0};
-    uint8_t *text = NULL;
-    size_t text_size = 0;
-    if (sl_read_file(o.scene, 16u << 20, &text, &text_size, &err) != SL_OK) {
-        fprintf(stderr, "sightline-render: %s\n", err.message);
-        return 2;
-    }
-    char *json = malloc(text_size + 1);
-    if (!json)
-        return 2;
-    memcpy(json, text, text_size);
-    json[text_size] = '\0';
-    free(text);
-    cJSON *root = cJSON_Parse(json);
-    free(json);
-    if (!root) {
-        fprintf(stderr, "sightline-render: %s is not valid JSON\n", o.scene);
-        return 2;
-    }
-    for (int i = 0; i < o.set_count; i++)
-        if (sl_scene_apply_override(root, o.sets[i], &err) != SL_OK) {
-            fprintf(stderr, "sightline-render: %s\n", err.message);
-            cJSON_Delete(root);
-            return 2;
-        }
+        return rc < 0 ? EXIT_OK : rc;
+    if (!check_outputs(&o))
+        return EXIT_BAD_INPUT;
     sl_scene scene;
-    sl_status st = sl_scene_from_json(root, &scene, &err);
-    cJSON_Delete(root);
+    if (!load_scene(&o, &scene))
+        return EXIT_BAD_INPUT;
+
+    /* The GPU and its limits first: cheap, and a failure there should not
+     * wait for a dataset load. */
+    sl_err err = {0};
+    sl_gpu *gpu = NULL;
+    sl_status st = sl_gpu_create(&(sl_gpu_desc){0}, &gpu, &err);
+    if (st == SL_OK)
+        st = sl_target_check(scene.width, scene.height, o.samples, &err);
     if (st != SL_OK) {
-        fprintf(stderr, "sightline-render: %s: %s\n", o.scene, err.message);
-        return 2;
+        fprintf(stderr, "sightline-render: GPU: %s\n", err.message);
+        if (o.samples > 1 && strstr(err.message, "MSAA"))
+            fprintf(stderr, "sightline-render: lower --samples (0 or 1 = no MSAA)\n");
+        sl_gpu_destroy(gpu);
+        sl_scene_deinit(&scene);
+        return EXIT_GPU;
     }
 
     char scene_dir[4096];
@@ -141,10 +339,11 @@ int main(int argc, char **argv)
     const char *data_dir = o.data_dir ? o.data_dir : dirname(scene_dir);
     sl_dataset *ds = NULL;
     double t0 = sl_now_ms();
-    if (sl_scene_open_dataset(&scene, data_dir, &ds, &err) != SL_OK) {
+    if ((st = sl_scene_open_dataset(&scene, data_dir, &ds, &err)) != SL_OK) {
         fprintf(stderr, "sightline-render: dataset: %s\n", err.message);
+        sl_gpu_destroy(gpu);
         sl_scene_deinit(&scene);
-        return 2;
+        return EXIT_BAD_INPUT; /* loaders never touch the GPU: an unsupported file variant is bad input */
     }
     double load_ms = sl_now_ms() - t0;
 
@@ -153,15 +352,8 @@ int main(int argc, char **argv)
     sl_params_init(&params, tech->params, tech->param_count);
     sl_params_apply_json(&params, scene.params, &err); /* validated by sl_scene_from_json */
 
-    sl_gpu *gpu = NULL;
-    if (sl_gpu_create(&(sl_gpu_desc){0}, &gpu, &err) != SL_OK) {
-        fprintf(stderr, "sightline-render: GPU: %s\n", err.message);
-        sl_dataset_destroy(ds);
-        sl_scene_deinit(&scene);
-        return 3;
-    }
     sl_pipeline *pipe = NULL;
-    int exit_code = 0;
+    int exit_code = EXIT_OK;
     double *gpu_ms = calloc((size_t)o.frames, sizeof(double));
     double *wall_ms = calloc((size_t)o.frames, sizeof(double));
     uint8_t *rgba = malloc((size_t)scene.width * (size_t)scene.height * 4);
@@ -170,21 +362,22 @@ int main(int argc, char **argv)
     sl_view view;
     if (!gpu_ms || !wall_ms || !rgba || (o.depth && !depth) || sl_pipeline_create(gpu, &pipe, &err) != SL_OK) {
         fprintf(stderr, "sightline-render: out of memory\n");
-        exit_code = 3;
+        exit_code = EXIT_BAD_INPUT;
         goto done;
     }
     sl_pipeline_set_dataset(pipe, ds);
-    if (sl_pipeline_set_technique(pipe, tech, &params, &err) != SL_OK) {
+    ds = NULL; /* owned by the pipeline now */
+    if ((st = sl_pipeline_set_technique(pipe, tech, &params, &err)) != SL_OK) {
         fprintf(stderr, "sightline-render: %s\n", err.message);
-        exit_code = 2;
+        exit_code = exit_for(st);
         goto done;
     }
     for (int f = 0; f < o.frames; f++) {
         sl_frame_stats stats;
-        if (sl_scene_view(&scene, sl_pipeline_dataset(pipe), f, &view, &err) != SL_OK ||
-            sl_pipeline_render(pipe, &view, o.samples, &stats, &err) != SL_OK) {
+        if ((st = sl_scene_view(&scene, sl_pipeline_dataset(pipe), f, &view, &err)) != SL_OK ||
+            (st = sl_pipeline_render(pipe, &view, o.samples, &stats, &err)) != SL_OK) {
             fprintf(stderr, "sightline-render: frame %d: %s\n", f, err.message);
-            exit_code = err.status == SL_ERR_GPU ? 3 : 2;
+            exit_code = exit_for(st);
             goto done;
         }
         if (f == 0)
@@ -199,48 +392,26 @@ int main(int argc, char **argv)
              : sl_png_write(o.out, rgba, scene.width, scene.height, &err);
     if (st != SL_OK) {
         fprintf(stderr, "sightline-render: %s\n", err.message);
-        exit_code = 2;
+        exit_code = EXIT_BAD_INPUT;
         goto done;
     }
     if (o.depth) {
         sl_frame_stats stats;
-        if (sl_pipeline_render(pipe, &view, 1, &stats, &err) != SL_OK) {
+        if ((st = sl_pipeline_render(pipe, &view, 1, &stats, &err)) != SL_OK) {
             fprintf(stderr, "sightline-render: depth frame: %s\n", err.message);
-            exit_code = 3;
+            exit_code = exit_for(st);
             goto done;
         }
         sl_pipeline_read_distance(pipe, &view, depth);
         if (sl_pfm_write(o.depth, depth, scene.width, scene.height, &err) != SL_OK) {
             fprintf(stderr, "sightline-render: %s\n", err.message);
-            exit_code = 2;
+            exit_code = EXIT_BAD_INPUT;
             goto done;
         }
     }
-    if (o.stats) {
-        cJSON *s = cJSON_CreateObject();
-        cJSON_AddStringToObject(s, "renderer", sl_gpu_renderer(gpu));
-        cJSON_AddStringToObject(s, "technique", tech->name);
-        cJSON_AddNumberToObject(s, "width", scene.width);
-        cJSON_AddNumberToObject(s, "height", scene.height);
-        cJSON_AddNumberToObject(s, "frames", o.frames);
-        cJSON_AddNumberToObject(s, "samples", o.samples);
-        cJSON_AddItemToObject(s, "gpu_ms", summary(gpu_ms, o.frames));
-        cJSON_AddItemToObject(s, "wall_ms", summary(wall_ms, o.frames));
-        cJSON_AddNumberToObject(s, "dataset_load_ms", load_ms);
-        cJSON_AddNumberToObject(s, "prepare_ms", first.prepare_ms);
-        cJSON_AddNumberToObject(s, "gpu_bytes", (double)last.gpu_bytes);
-        cJSON_AddNumberToObject(s, "primitives", last.render.primitives);
-        cJSON_AddNumberToObject(s, "culled", last.render.culled);
-        char *out = cJSON_Print(s);
-        FILE *f = fopen(o.stats, "w");
-        if (!f || !out || fputs(out, f) < 0) {
-            fprintf(stderr, "sightline-render: cannot write %s\n", o.stats);
-            exit_code = 2;
-        }
-        if (f)
-            fclose(f);
-        free(out);
-        cJSON_Delete(s);
+    if (o.stats && !write_stats(&o, &scene, gpu, tech, gpu_ms, wall_ms, load_ms, &first, &last)) {
+        exit_code = EXIT_BAD_INPUT;
+        goto done;
     }
     printf("wrote %s (%dx%d, %s, %d frame%s)\n", o.out, scene.width, scene.height, tech->name, o.frames,
            o.frames == 1 ? "" : "s");
@@ -249,10 +420,8 @@ done:
     free(wall_ms);
     free(rgba);
     free(depth);
-    if (pipe)
-        sl_pipeline_destroy(pipe);
-    else
-        sl_dataset_destroy(ds);
+    sl_pipeline_destroy(pipe);
+    sl_dataset_destroy(ds);
     sl_gpu_destroy(gpu);
     sl_scene_deinit(&scene);
     return exit_code;

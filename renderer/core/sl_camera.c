@@ -12,16 +12,15 @@ sl_status sl_camera_from_orbit(const sl_orbit *orbit, sl_vec3 lo, sl_vec3 hi,
         return sl_err_set(err, SL_ERR_INVALID, "camera.orbit: azimuth, elevation, distance and fov_y must be finite numbers");
     if (orbit->distance <= 0.0)
         return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.distance must be > 0 (bounding-sphere radii), got %g", orbit->distance);
+    if (fabs(orbit->elevation_deg) > SL_ORBIT_MAX_ELEVATION)
+        return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.elevation must be in [%g, %g] degrees, got %g",
+                          -SL_ORBIT_MAX_ELEVATION, SL_ORBIT_MAX_ELEVATION, orbit->elevation_deg);
     sl_vec3 centre = sl_v3_scale(sl_v3_add(lo, hi), 0.5);
     double radius = 0.5 * sl_v3_length(sl_v3_sub(hi, lo));
     if (!(radius > 0.0))
         radius = 1.0;
     double az = orbit->azimuth_deg * SL_PI / 180.0;
     double el = orbit->elevation_deg * SL_PI / 180.0;
-    /* Keep the view direction off the pole so that up = +y stays usable. */
-    const double max_el = 89.9 * SL_PI / 180.0;
-    if (el > max_el) el = max_el;
-    if (el < -max_el) el = -max_el;
     sl_vec3 dir = sl_v3(cos(el) * sin(az), sin(el), cos(el) * cos(az));
     out->eye = sl_v3_add(centre, sl_v3_scale(dir, orbit->distance * radius));
     out->target = centre;

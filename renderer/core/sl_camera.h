@@ -25,7 +25,10 @@ typedef struct sl_camera {
 } sl_camera;
 
 /* An orbit about the bounds centre: azimuth about +y from +z towards +x,
- * elevation towards +y, distance in bounding-sphere radii, up = +y. */
+ * elevation towards +y, distance in bounding-sphere radii, up = +y.
+ * Elevation is limited to +-SL_ORBIT_MAX_ELEVATION degrees, off the poles,
+ * where up = +y would be parallel to the view direction. */
+#define SL_ORBIT_MAX_ELEVATION 89.9
 typedef struct sl_orbit {
     double azimuth_deg, elevation_deg, distance;
     double fov_y_deg;
@@ -48,7 +51,9 @@ typedef struct sl_view {
     sl_mat4 view_projection;
 } sl_view;
 
-/* Camera from an orbit about bounds [lo, hi]. Fails on NaN or a distance <= 0. */
+/* Camera from an orbit about bounds [lo, hi]. Fails (SL_ERR_INVALID, naming
+ * the field and range) on NaN, a distance <= 0 or an elevation outside
+ * [-SL_ORBIT_MAX_ELEVATION, SL_ORBIT_MAX_ELEVATION]. */
 sl_status sl_camera_from_orbit(const sl_orbit *orbit, sl_vec3 lo, sl_vec3 hi,
                                sl_camera *out, sl_err *err);
 

@@ -1,8 +1,11 @@
 /* sl_gpu.h — headless OpenGL 4.5 core: EGL context, embedded shaders, targets, timers.
  *
- * sl_gpu_create picks a hardware GPU through EGL_EXT_platform_device (software
- * devices skipped), else Mesa's surfaceless platform (llvmpipe);
- * SIGHTLINE_EGL_DEVICE=software|<index> overrides. The context is current
+ * sl_gpu_create tries each hardware GPU of EGL_EXT_platform_device (software
+ * devices skipped), then Mesa's surfaceless platform (llvmpipe), and keeps
+ * the first that gives an OpenGL 4.5 core context;
+ * SIGHTLINE_EGL_DEVICE=<index> picks that device with no fallback, and
+ * SIGHTLINE_EGL_DEVICE=software a CPU rasterizer (Mesa's software EGL
+ * device, else surfaceless, as long as the renderer is llvmpipe/softpipe). The context is current
  * on the creating thread and every function here, and every technique's
  * prepare/render/release, must run on that thread (the render thread).
  * Shaders are .glsl files under renderer/ embedded at build time and named
@@ -26,13 +29,22 @@ typedef struct sl_gpu sl_gpu;
 typedef struct sl_gpu_desc {
     const char *device;  /* NULL: $SIGHTLINE_EGL_DEVICE, else auto; "software" or "<index>" */
     int debug;           /* install a KHR_debug callback that prints GL errors */
-    int quiet;           /* do not print the renderer string */
+    int quiet;           /* do not print the renderer string (nor the candidates skipped) */
+    int software_devices;/* auto: also try EGL devices that are software renderers, before surfaceless */
+    unsigned test_fail_mask; /* tests only: candidate i (in trial order) fails as if its
+                                context could not be made when bit i is set; 0 in programs */
 } sl_gpu_desc;
 
+/* Fails with SL_ERR_INVALID for a malformed device choice, SL_ERR_GPU when
+ * no candidate gives a 4.5 core context (the message names every candidate
+ * tried and why it failed, or says there is no EGL display at all). */
 sl_status sl_gpu_create(const sl_gpu_desc *desc, sl_gpu **out, sl_err *err);
 void sl_gpu_destroy(sl_gpu *gpu);
 const char *sl_gpu_renderer(const sl_gpu *gpu);  /* GL_RENDERER string */
+/* 1 when GL_RENDERER names a CPU rasterizer (llvmpipe, softpipe, swrast) or
+ * the EGL device says EGL_MESA_device_software. */
 int sl_gpu_is_software(const sl_gpu *gpu);
+const char *sl_gpu_display_name(const sl_gpu *gpu); /* "EGL device N" or "Mesa surfaceless" */
 
 /* Embedded files (generated at build time). */
 typedef struct sl_embedded_file {
@@ -79,6 +91,12 @@ typedef struct sl_target {
     GLuint resolve_fbo, resolve_color, resolve_depth; /* single-sample; == fbo/color/depth when samples <= 1 */
 } sl_target;
 
+/* Whether this GPU can hold a width x height target with `samples` MSAA
+ * samples (0 or 1 = none); the context must be current. SL_ERR_UNSUPPORTED
+ * names the GPU's limit (size: texture, renderbuffer and framebuffer limits;
+ * samples: GL_MAX_SAMPLES and the colour/depth texture sample limits);
+ * SL_ERR_INVALID for a size below 1. sl_target_init checks the same. */
+sl_status sl_target_check(int width, int height, int samples, sl_err *err);
 sl_status sl_target_init(sl_target *t, int width, int height, int samples, sl_err *err);
 void sl_target_deinit(sl_target *t);
 /* Binds the target, sets viewport, clip control 0..1 and clears colour to

@@ -36,16 +36,42 @@ static sl_status make_fbo(GLuint color, GLuint depth, GLuint *fbo, sl_err *err)
     return SL_OK;
 }
 
+static GLint min_limit(const GLenum *names, int n)
+{
+    GLint best = 0;
+    for (int i = 0; i < n; i++) {
+        GLint v = 0;
+        glGetIntegerv(names[i], &v);
+        if (i == 0 || v < best)
+            best = v;
+    }
+    return best;
+}
+
+sl_status sl_target_check(int width, int height, int samples, sl_err *err)
+{
+    /* Colour and depth are textures (multisampled ones with MSAA) attached
+     * to one framebuffer: every one of these limits applies. */
+    static const GLenum size_limits[] = {GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_FRAMEBUFFER_WIDTH,
+                                         GL_MAX_FRAMEBUFFER_HEIGHT};
+    static const GLenum sample_limits[] = {GL_MAX_SAMPLES, GL_MAX_COLOR_TEXTURE_SAMPLES, GL_MAX_DEPTH_TEXTURE_SAMPLES};
+    GLint max_size = min_limit(size_limits, 4);
+    GLint max_samples = min_limit(sample_limits, 3);
+    if (width < 1 || height < 1 || width > max_size || height > max_size)
+        return sl_err_set(err, width < 1 || height < 1 ? SL_ERR_INVALID : SL_ERR_UNSUPPORTED,
+                          "target size %dx%d is outside 1..%d on this GPU", width, height, (int)max_size);
+    if (samples > 1 && samples > max_samples)
+        return sl_err_set(err, SL_ERR_UNSUPPORTED, "%d MSAA samples requested, this GPU offers at most %d", samples,
+                          (int)max_samples);
+    return SL_OK;
+}
+
 sl_status sl_target_init(sl_target *t, int width, int height, int samples, sl_err *err)
 {
     memset(t, 0, sizeof *t);
-    GLint max_size = 0, max_samples = 0;
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
-    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-    if (width < 1 || height < 1 || width > max_size || height > max_size)
-        return sl_err_set(err, SL_ERR_LIMIT, "target size %dx%d is outside 1..%d", width, height, max_size);
-    if (samples > max_samples)
-        return sl_err_set(err, SL_ERR_LIMIT, "%d MSAA samples requested, the GPU offers at most %d", samples, max_samples);
+    sl_status check = sl_target_check(width, height, samples, err);
+    if (check != SL_OK)
+        return check;
     t->width = width;
     t->height = height;
     t->samples = samples > 1 ? samples : 1;

@@ -3,11 +3,15 @@
  * Colour: d = max over R, G, B of |a - b| (alpha ignored); mean/max of d over
  * all pixels; PSNR = 10 log10(255^2 / MSE) with MSE over the R, G, B samples
  * (INFINITY when MSE = 0); bad = pixels with d > bad_threshold.
- * Depth: a pixel is hit when its value is finite and > 0. Statistics are over
- * pixels hit in both; coverage mismatch counts pixels hit in exactly one, as
- * a percentage of pixels hit in either (0 when none is hit). Depth PSNR uses
- * peak = the largest depth among compared pixels; INFINITY when MSE = 0 or
- * nothing is compared. All sums in double, so the result does not depend on
+ * Depth: a pixel is hit when its value is finite and > 0. mean, max and PSNR
+ * are over pixels hit in both (a difference is only defined there); bad
+ * pixels are those hit in both with d > bad_threshold plus every coverage
+ * mismatch (hit in exactly one), and bad_pct is over the pixels hit in either,
+ * so two maps that share no hit are 100 % bad, never a silent pass. Coverage
+ * mismatch is also reported on its own, as a count and as a percentage of the
+ * pixels hit in either (0 when none is hit). Depth PSNR uses peak = the
+ * largest depth among pixels hit in both; INFINITY when MSE = 0 or no pixel
+ * is hit in both. All sums in double, so the result does not depend on
  * image size beyond double rounding. Any thread; no GL.
  * Heat map (RGBA8): black = equal; otherwise t = d / max(max_abs, bad_threshold)
  * ramps dark red -> red -> yellow -> white (any non-zero difference is visibly
@@ -85,7 +89,7 @@ sl_status sl_diff_images(const sl_image *a, const sl_image *b, double bad_thresh
     memset(out, 0, sizeof *out);
     out->width = a->width;
     out->height = a->height;
-    out->compared = (long)n;
+    out->compared = out->both_hit = (long)n;
     out->mean_abs = sum / (double)n;
     out->max_abs = max_d;
     double mse = sq / (3.0 * (double)n);
@@ -134,7 +138,7 @@ sl_status sl_diff_depths(const sl_depth_image *a, const sl_depth_image *b, doubl
 
     size_t n = (size_t)a->width * (size_t)a->height;
     double sum = 0.0, sq = 0.0, max_d = 0.0, peak = 0.0;
-    long bad = 0, compared = 0, mismatch = 0, either = 0;
+    long bad = 0, both = 0, mismatch = 0, either = 0;
     for (size_t i = 0; i < n; i++) {
         int ha = is_hit(a->values[i]), hb = is_hit(b->values[i]);
         if (ha || hb)
@@ -147,7 +151,7 @@ sl_status sl_diff_depths(const sl_depth_image *a, const sl_depth_image *b, doubl
             continue;
         double va = a->values[i], vb = b->values[i];
         double d = fabs(va - vb);
-        compared++;
+        both++;
         sum += d;
         sq += d * d;
         if (d > max_d)
@@ -162,13 +166,14 @@ sl_status sl_diff_depths(const sl_depth_image *a, const sl_depth_image *b, doubl
     memset(out, 0, sizeof *out);
     out->width = a->width;
     out->height = a->height;
-    out->compared = compared;
-    out->mean_abs = compared ? sum / (double)compared : 0.0;
+    out->compared = either;
+    out->both_hit = both;
+    out->mean_abs = both ? sum / (double)both : 0.0;
     out->max_abs = max_d;
-    double mse = compared ? sq / (double)compared : 0.0;
+    double mse = both ? sq / (double)both : 0.0;
     out->psnr_db = mse > 0.0 ? 10.0 * log10(peak * peak / mse) : INFINITY;
-    out->bad_count = bad;
-    out->bad_pct = compared ? 100.0 * (double)bad / (double)compared : 0.0;
+    out->bad_count = bad + mismatch;
+    out->bad_pct = either ? 100.0 * (double)(bad + mismatch) / (double)either : 0.0;
     out->coverage_mismatch = mismatch;
     out->coverage_mismatch_pct = either ? 100.0 * (double)mismatch / (double)either : 0.0;
 

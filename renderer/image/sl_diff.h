@@ -3,8 +3,10 @@
  * Colour: per-pixel difference is the max over R, G, B of |a - b| in 0..255;
  * mean and max of that, PSNR over RGB (dB; INFINITY when identical), and the
  * percentage of pixels whose difference exceeds bad_threshold.
- * Depth (0 = nothing hit): the same statistics over pixels both hit, plus the
- * coverage mismatch: pixels hit in exactly one of the two, as a count and
+ * Depth (0 = nothing hit): mean, max and PSNR over pixels hit in both; bad
+ * pixels are the pixels hit in both whose difference exceeds bad_threshold
+ * plus every coverage mismatch (hit in exactly one), as a percentage of the
+ * pixels hit in either; and the coverage mismatch on its own, as a count and
  * as a percentage of the pixels hit in either. Any thread.
  */
 #ifndef SL_DIFF_H
@@ -16,8 +18,10 @@ typedef struct sl_diff_result {
     int width, height;
     double mean_abs, max_abs;   /* colour: 0..255 units; depth: world units */
     double psnr_db;             /* colour only (depth: over pixels both hit, peak = max depth) */
-    double bad_pct;             /* % of compared pixels with difference > threshold */
-    long bad_count, compared;   /* compared = all pixels (colour) or pixels both hit (depth) */
+    double bad_pct;             /* 100 * bad_count / compared (0 when compared == 0) */
+    long bad_count;             /* difference > threshold; depth: + coverage mismatches */
+    long compared;              /* all pixels (colour) or pixels hit in either (depth) */
+    long both_hit;              /* pixels mean/max/PSNR are over: all (colour) or hit in both (depth) */
     long coverage_mismatch;     /* depth only */
     double coverage_mismatch_pct;
 } sl_diff_result;

@@ -430,9 +430,21 @@ static void test_orbit(void)
     SL_CHECK(sl_view_init(&v, radius, &err) == SL_OK);
     SL_CHECK(fabs(v.right.x - 1) < 1e-15 && fabs(v.upv.y - 1) < 1e-15 && fabs(v.forward.z + 1) < 1e-15);
 
-    /* Elevation +-90 (and beyond): handled without NaN; the eye stays at the
-     * orbit distance, above (below) the centre, and a view can be built. */
-    const double poles[] = {90.0, -90.0, 89.99999, 90.0 + 1e-9, 135.0, -400.0};
+    /* Elevation beyond +-89.9 (the poles, where up = +y is parallel to the
+     * view direction, and past them) is an error naming the field and the
+     * range, not a silent clamp. */
+    const double beyond[] = {90.0, -90.0, 89.90001, -89.90001, 90.0 + 1e-9, 135.0, -400.0};
+    for (size_t k = 0; k < sizeof beyond / sizeof beyond[0]; k++) {
+        sl_orbit p = {37.0, beyond[k], 2.5, 45.0};
+        memset(&err, 0, sizeof err);
+        sl_status st = sl_camera_from_orbit(&p, to_sl(lo), to_sl(hi), &cam, &err);
+        SL_CHECK_MSG(st == SL_ERR_INVALID, "elevation %.9g accepted", beyond[k]);
+        SL_CHECK_MSG(strstr(err.message, "camera.orbit.elevation must be in [-89.9, 89.9] degrees"), "%s",
+                     err.message);
+    }
+    /* At the limits (and near them): no NaN; the eye stays at the orbit
+     * distance, almost straight above (below) the centre, and a view can be built. */
+    const double poles[] = {SL_ORBIT_MAX_ELEVATION, -SL_ORBIT_MAX_ELEVATION, 89.89999, -89.5};
     for (size_t k = 0; k < sizeof poles / sizeof poles[0]; k++) {
         sl_orbit p = {37.0, poles[k], 2.5, 45.0};
         sl_status st = sl_camera_from_orbit(&p, to_sl(lo), to_sl(hi), &v.camera, &err);
@@ -441,11 +453,9 @@ static void test_orbit(void)
             continue;
         SL_CHECK(vec_finite(v.camera.eye));
         SL_CHECK_NEAR(dlen(dsub(from_sl(v.camera.eye), centre)), 2.5 * radius, 1e-9);
-        if (fabs(poles[k]) == 90.0) {
-            double sgn = poles[k] > 0 ? 1.0 : -1.0;
-            SL_CHECK_MSG(sgn * (v.camera.eye.y - centre.y) > 0.999 * 2.5 * radius, "elevation %g: eye.y %g",
-                         poles[k], v.camera.eye.y);
-        }
+        double sgn = poles[k] > 0 ? 1.0 : -1.0;
+        SL_CHECK_MSG(sgn * (v.camera.eye.y - centre.y) > 0.9999 * 2.5 * radius, "elevation %g: eye.y %g",
+                     poles[k], v.camera.eye.y);
         v.width = 64;
         v.height = 48;
         v.near_plane = 0;

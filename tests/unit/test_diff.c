@@ -195,16 +195,17 @@ static void test_depth(void)
     SL_CHECK(sl_diff_depths(&a, &b, 1e-3, &r, &heat, &err) == SL_OK);
     long mismatch = 5 + 3 + 1 + 1;                     /* + NaN (70) + negative (82) */
     long either = 100 - 1;                             /* all but pixel 60 */
-    long compared = either - mismatch;
+    long both = either - mismatch;
     SL_CHECK_MSG(r.coverage_mismatch == mismatch, "mismatch %ld", r.coverage_mismatch);
     SL_CHECK_NEAR(r.coverage_mismatch_pct, 100.0 * mismatch / either, 1e-12);
-    SL_CHECK(r.compared == compared);
+    SL_CHECK_MSG(r.compared == either && r.both_hit == both, "compared %ld, both_hit %ld", r.compared, r.both_hit);
     double d81 = fabs((double)1.0005f - 1.0);
     SL_CHECK_NEAR(r.max_abs, 0.5, 0.0);
-    SL_CHECK_NEAR(r.mean_abs, (0.5 + d81) / compared, 1e-15);
-    SL_CHECK(r.bad_count == 1);
-    SL_CHECK_NEAR(r.bad_pct, 100.0 / compared, 1e-12);
-    double mse = (0.25 + d81 * d81) / compared;
+    SL_CHECK_NEAR(r.mean_abs, (0.5 + d81) / both, 1e-15);
+    /* Bad: pixel 80 (0.5 > 1e-3) and every coverage mismatch, over the pixels hit in either. */
+    SL_CHECK_MSG(r.bad_count == 1 + mismatch, "bad_count %ld", r.bad_count);
+    SL_CHECK_NEAR(r.bad_pct, 100.0 * (1 + mismatch) / either, 1e-12);
+    double mse = (0.25 + d81 * d81) / both;
     SL_CHECK_NEAR(r.psnr_db, 10.0 * log10(1.5 * 1.5 / mse), 1e-9);
     if (heat) {
         const uint8_t *p = heat + 0 * 4;
@@ -230,6 +231,23 @@ static void test_depth(void)
     sl_depth_image z1 = make_depth(4, 4, 0.0f), z2 = make_depth(4, 4, 0.0f);
     SL_CHECK(sl_diff_depths(&z1, &z2, 1e-3, &r, NULL, &err) == SL_OK);
     SL_CHECK(r.compared == 0 && r.coverage_mismatch_pct == 0.0 && r.bad_pct == 0.0 && r.mean_abs == 0.0);
+
+    /* Nothing hit in a, everything in b: no pixel is hit in both, so mean and
+     * max are 0 over nothing, but every pixel is bad and a coverage mismatch. */
+    sl_depth_image full = make_depth(4, 4, 3.0f);
+    SL_CHECK(sl_diff_depths(&z1, &full, 1e-3, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.both_hit == 0 && r.compared == 16 && r.coverage_mismatch == 16);
+    SL_CHECK(r.bad_count == 16 && r.bad_pct == 100.0 && r.coverage_mismatch_pct == 100.0);
+    SL_CHECK(r.mean_abs == 0.0 && r.max_abs == 0.0);
+    /* Half the pixels hit in both (equal), the other half only in b: 50 % bad
+     * even with a threshold that no difference exceeds. */
+    for (int i = 0; i < 8; i++)
+        z1.values[i] = 3.0f;
+    SL_CHECK(sl_diff_depths(&z1, &full, 1e9, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.both_hit == 8 && r.compared == 16 && r.bad_count == 8);
+    SL_CHECK_NEAR(r.bad_pct, 50.0, 0.0);
+    SL_CHECK_NEAR(r.coverage_mismatch_pct, 50.0, 0.0);
+    sl_depth_image_deinit(&full);
 
     SL_CHECK(sl_diff_depths(&a, &z1, 1e-3, &r, NULL, &err) == SL_ERR_INVALID);
     SL_CHECK(strstr(err.message, "sizes differ") != NULL);
@@ -345,7 +363,10 @@ static void test_tool(void)
     SL_CHECK(cJSON_IsString(kind) && strcmp(kind->valuestring, "depth") == 0);
     SL_CHECK_NEAR(json_number(j, "coverage_mismatch"), 1.0, 0.0);
     SL_CHECK_NEAR(json_number(j, "coverage_mismatch_pct"), 100.0 / 64.0, 1e-12);
-    SL_CHECK_NEAR(json_number(j, "compared"), 63.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "compared"), 64.0, 0.0);   /* hit in either */
+    SL_CHECK_NEAR(json_number(j, "both_hit"), 63.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "bad_count"), 2.0, 0.0);   /* pixel 6 (0.25) + the mismatch */
+    SL_CHECK_NEAR(json_number(j, "bad_pct"), 200.0 / 64.0, 1e-12);
     SL_CHECK_NEAR(json_number(j, "max_abs"), 0.25, 0.0);
     SL_CHECK_NEAR(json_number(j, "bad_threshold"), 1e-3, 0.0);
     SL_CHECK(json_has_failed(j, "max_coverage_pct"));
@@ -353,6 +374,62 @@ static void test_tool(void)
     snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-abs 0.3", tmpdir, tmpdir);
     SL_CHECK(run_tool(args, &j) == 0);
     cJSON_Delete(j);
+    /* --max-bad-pct sees the mismatch as well as the 0.25 difference: 2 of 64 bad (3.125 %). */
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-bad-pct 3.2", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    cJSON_Delete(j);
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-bad-pct 3", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK(j && json_has_failed(j, "max_bad_pct"));
+    cJSON_Delete(j);
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-bad-pct 3 --bad-threshold 0.5",
+             tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    SL_CHECK(j && json_number(j, "bad_count") == 1.0);      /* the mismatch alone */
+    cJSON_Delete(j);
+    snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 2 --max-bad-pct 1.5 --bad-threshold 0.5",
+             tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK(j && json_has_failed(j, "max_bad_pct") && !json_has_failed(j, "max_coverage_pct"));
+    cJSON_Delete(j);
+
+    /* An empty depth map against one with hits: the audit's false pass. Mean
+     * and max see no pixel hit in both (0), so --max-mean 0 alone must fail
+     * through the implicit coverage limit, and --max-bad-pct through the
+     * mismatches counted as bad. */
+    sl_depth_image empty = make_depth(8, 8, 0.0f);
+    SL_CHECK(sl_pfm_write(tmp_path("empty.pfm"), empty.values, 8, 8, &err) == SL_OK);
+    snprintf(args, sizeof args, "%s/empty.pfm %s/a.pfm --max-mean 0", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK_MSG(j != NULL, "empty vs full: stdout is not JSON");
+    SL_CHECK(cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(j, "pass")));
+    SL_CHECK(json_has_failed(j, "max_coverage_pct") && !json_has_failed(j, "max_mean"));
+    SL_CHECK_NEAR(json_number(j, "bad_pct"), 100.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "both_hit"), 0.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "coverage_mismatch_pct"), 100.0, 0.0);
+    const cJSON *lims = cJSON_GetObjectItemCaseSensitive(j, "limits");
+    SL_CHECK(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(lims, "max_coverage_pct_implicit")));
+    SL_CHECK(json_number(lims, "max_coverage_pct") == 0.0);
+    cJSON_Delete(j);
+    snprintf(args, sizeof args, "%s/empty.pfm %s/a.pfm --max-coverage-pct 100 --max-bad-pct 99", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK(j && json_has_failed(j, "max_bad_pct") && !json_has_failed(j, "max_coverage_pct"));
+    cJSON_Delete(j);
+    /* A coverage limit given explicitly replaces the implicit one. */
+    snprintf(args, sizeof args, "%s/empty.pfm %s/a.pfm --max-coverage-pct 100 --max-mean 0", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    SL_CHECK(j && !cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(j, "limits"),
+                                                    "max_coverage_pct_implicit"));
+    cJSON_Delete(j);
+    /* No limit at all: metrics only, exit 0. */
+    snprintf(args, sizeof args, "%s/empty.pfm %s/a.pfm", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    cJSON_Delete(j);
+    /* Identical coverage: the implicit limit does not get in the way. */
+    snprintf(args, sizeof args, "%s/a.pfm %s/a.pfm --max-mean 0 --max-abs 0", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    cJSON_Delete(j);
+    sl_depth_image_deinit(&empty);
 
     /* Bad input: exit 2, nothing on stdout. */
     const char *bad[] = {

@@ -251,6 +251,24 @@ static void test_invalid(void)
     parse_bad("{\"dataset\": \"x.vtk\", \"orbit_frames\": 2.5}", "orbit_frames", NULL, NULL);
     parse_bad("{\"dataset\": \"x.vtk\", \"orbit_frames\": 1000001}", "orbit_frames", NULL, NULL);
     parse_bad("{\"dataset\": \"x.vtk\", \"orbit_frames\": \"4\"}", "orbit_frames", NULL, NULL);
+    /* orbit_frames turns an orbit: with eye/target/up it would be ignored, so it is an error. */
+    parse_bad("{\"dataset\": \"x.vtk\", \"orbit_frames\": 4, \"camera\": {\"eye\": [0, 0, 5], \"target\": [0, 0, 0]}}",
+              "orbit_frames", "orbit camera", "eye/target/up");
+    sl_scene ok;
+    if (parse_ok("{\"dataset\": \"x.vtk\", \"orbit_frames\": 0, \"camera\": {\"eye\": [0, 0, 5], \"target\": [0, 0, 0]}}",
+                 &ok)) {
+        SL_CHECK(!ok.camera_is_orbit && ok.orbit_frames == 0);
+        sl_scene_deinit(&ok);
+    }
+    if (parse_ok("{\"dataset\": \"x.vtk\", \"orbit_frames\": 8}", &ok)) {   /* the default camera is an orbit */
+        SL_CHECK(ok.camera_is_orbit && ok.orbit_frames == 8);
+        sl_scene_deinit(&ok);
+    }
+    /* Elevation at its limits is accepted as given (no clamp). */
+    if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"orbit\": {\"elevation\": -89.9}}}", &ok)) {
+        SL_CHECK(ok.orbit.elevation_deg == -89.9);
+        sl_scene_deinit(&ok);
+    }
 
     /* Cameras. */
     const struct { const char *cam, *w1, *w2; } cams[] = {
@@ -287,6 +305,13 @@ static void test_invalid(void)
         {"{\"orbit\": {\"elevation\": -1e400}}", "camera.orbit.elevation", "finite"},
         {"{\"orbit\": {\"azimuth\": true}}", "camera.orbit.azimuth", NULL},
         {"{\"orbit\": {\"elevation\": null}}", "camera.orbit.elevation", NULL},
+        {"{\"orbit\": {\"elevation\": 100}}", "camera.orbit.elevation", "[-89.9, 89.9]"},
+        {"{\"orbit\": {\"elevation\": -90}}", "camera.orbit.elevation", "got -90"},
+        {"{\"orbit\": {\"elevation\": 89.90001}}", "camera.orbit.elevation", "[-89.9, 89.9]"},
+        /* Both forms: the conflict is named first, with the fields found, even with up present. */
+        {"{\"orbit\": {\"distance\": 2}, \"eye\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0]}",
+         "not both", "orbit and eye, target"},
+        {"{\"orbit\": {\"distance\": 2}, \"up\": [0, 1, 0]}", "camera.up", "always +y"},
     };
     for (size_t k = 0; k < sizeof cams / sizeof cams[0]; k++) {
         snprintf(text, sizeof text, "{\"dataset\": \"x.vtk\", \"camera\": %s}", cams[k].cam);
@@ -374,6 +399,32 @@ static void test_overrides(void)
         SL_CHECK(cJSON_IsNumber(sd) && sd->valuedouble == 8);
         sl_scene_deinit(&s);
     }
+    /* An orbit field on an eye/target/up camera: the up goes with eye and target
+     * (it used to stay and fail as "an orbit camera's up is always +y"). */
+    const char *with_up = "{\"dataset\": \"tornado\", \"camera\": {\"eye\": [0, 0, 5], \"target\": [0, 0, 0],"
+                          " \"up\": [0, 1, 0], \"fov_y\": 40}}";
+    const char *sets_up[] = {"camera.orbit.distance=2"};
+    st = parse_with(with_up, sets_up, 1, &s, &err);
+    SL_CHECK_MSG(st == SL_OK, "orbit over eye/target/up: %s", err.message);
+    if (st == SL_OK) {
+        SL_CHECK(s.camera_is_orbit && s.orbit.distance == 2.0 && s.orbit.azimuth_deg == 30.0 &&
+                 s.orbit.elevation_deg == 20.0 && s.orbit.fov_y_deg == 40.0);
+        sl_scene_deinit(&s);
+    }
+    const char *sets_up2[] = {"camera.orbit={\"azimuth\": 5}"};
+    st = parse_with(with_up, sets_up2, 1, &s, &err);
+    SL_CHECK_MSG(st == SL_OK && s.camera_is_orbit && s.orbit.azimuth_deg == 5.0, "camera.orbit={...}: %s",
+                 st ? err.message : "wrong orbit");
+    if (st == SL_OK)
+        sl_scene_deinit(&s);
+    /* An up set on an orbit camera is still refused (it cannot apply). */
+    const char *sets_up3[] = {"camera.up=[0,0,1]"};
+    st = parse_with("{\"dataset\": \"tornado\", \"camera\": {\"orbit\": {}}}", sets_up3, 1, &s, &err);
+    SL_CHECK_MSG(st == SL_ERR_INVALID && strstr(err.message, "camera.up"), "up on an orbit: %s",
+                 st ? err.message : "accepted");
+    if (st == SL_OK)
+        sl_scene_deinit(&s);
+
     const char *sets2[] = {"params.radius=0.5", "camera.orbit.azimuth=-12.5", "camera.orbit.distance=4"};
     st = parse_with("{\"dataset\": \"tornado\"}", sets2, 3, &s, &err);
     SL_CHECK_MSG(st == SL_OK, "%s", err.message);
