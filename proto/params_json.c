@@ -4,7 +4,46 @@
 #include "data/sl_dataset.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+/* "a, b, c": the choices of an enum, for messages. */
+static void choice_list(const sl_param_def *d, char *list, size_t size)
+{
+    list[0] = '\0';
+    for (int k = 0; d->choices[k]; k++) {
+        if (k)
+            strncat(list, ", ", size - strlen(list) - 1);
+        strncat(list, d->choices[k], size - strlen(list) - 1);
+    }
+}
+
+/* A number given for an enum: the choice of that name when the choices are
+ * numbers (quantization 4 means "4", not the fifth choice), else an index.
+ * When some choice names are numbers and none matches, it is refused rather
+ * than read as an index, which would silently mean another value. */
+static sl_status apply_enum_number(sl_params *p, const sl_param_def *d, double v, sl_err *err)
+{
+    char text[32];
+    snprintf(text, sizeof text, "%.17g", v);
+    int numeric_names = 0;
+    for (int k = 0; d->choices[k]; k++) {
+        char *end = NULL;
+        double c = strtod(d->choices[k], &end);
+        if (end != d->choices[k] && *end == '\0') {
+            numeric_names = 1;
+            if (c == v)
+                return sl_params_set_choice(p, d->name, d->choices[k], err);
+        }
+    }
+    if (numeric_names) {
+        char list[400];
+        choice_list(d, list, sizeof list);
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' has no choice %s (choices: %s)", d->name, text, list);
+    }
+    return sl_params_set_numbers(p, d->name, &v, 1, err);
+}
 
 static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
 {
@@ -24,13 +63,9 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
         if (cJSON_IsString(item))
             return sl_params_set_choice(p, name, item->valuestring, err);
         if (cJSON_IsNumber(item))
-            return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
-        char list[400] = "";
-        for (int k = 0; d->choices[k]; k++) {
-            if (k)
-                strncat(list, ", ", sizeof list - strlen(list) - 1);
-            strncat(list, d->choices[k], sizeof list - strlen(list) - 1);
-        }
+            return apply_enum_number(p, d, item->valuedouble, err);
+        char list[400];
+        choice_list(d, list, sizeof list);
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a choice name (choices: %s)", name, list);
     }
     case SL_PARAM_VEC3: {

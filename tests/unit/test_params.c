@@ -282,7 +282,18 @@ static void test_parameter(const sl_technique *t, int i)
     if (d->type == SL_PARAM_INT && d->min < d->max)
         expect_refused_numbers(&base, d, d->min + 0.5, "not an integer");
     if (d->type == SL_PARAM_ENUM) {
-        expect_refused_numbers(&base, d, (double)choice_count(d), "index past the choices");
+        /* Past the last index, and no choice's name (numeric names are
+         * read as names, see test_numeric_enum). */
+        int past = choice_count(d);
+        for (int k = 0; d->choices[k]; k++) {
+            char text[32];
+            snprintf(text, sizeof text, "%d", past);
+            if (strcmp(d->choices[k], text) == 0) {
+                past++;
+                k = -1;
+            }
+        }
+        expect_refused_numbers(&base, d, (double)past, "index past the choices");
         expect_refused_numbers(&base, d, -1.0, "negative index");
         expect_refused_numbers(&base, d, 0.5, "fractional index");
     }
@@ -537,10 +548,36 @@ static void test_known_parameters(void)
     SL_CHECK(sl_params_float(&q, "radius") == 0.5);
 }
 
+/* An enum whose choices are numbers takes a JSON number as that choice's
+ * name, never as an index; a number that names no choice is refused. */
+static const char *const bins_choices[] = {"2", "4", "8", NULL};
+static const sl_param_def bins_schema[] = {
+    {.name = "bins", .type = SL_PARAM_ENUM, .def = {0}, .choices = bins_choices, .unit = "",
+     .description = "numeric choices", .invalidates = SL_INVALIDATE_FRAME},
+};
+
+static void test_numeric_enum(void)
+{
+    sl_params p;
+    sl_params_init(&p, bins_schema, 1);
+    sl_err err = {0};
+    cJSON *patch = cJSON_Parse("{\"bins\": 4}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && strcmp(sl_params_choice_name(&p, "bins"), "4") == 0);
+    cJSON_Delete(patch);
+    patch = cJSON_Parse("{\"bins\": 1}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_ERR_INVALID && strstr(err.message, "'bins'"));
+    SL_CHECK(strcmp(sl_params_choice_name(&p, "bins"), "4") == 0);
+    cJSON_Delete(patch);
+    patch = cJSON_Parse("{\"bins\": \"8\"}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && sl_params_choice(&p, "bins") == 2);
+    cJSON_Delete(patch);
+}
+
 int main(void)
 {
     test_techniques();
     test_private_schema();
+    test_numeric_enum();
     test_known_parameters();
     SL_TEST_END();
 }
