@@ -1,15 +1,21 @@
-/* sl_protocol.c — parse client messages, build error messages, pack frame headers.
+/* sl_protocol.c — parse client messages, serialize server messages, pack frame headers.
  *
  * Each message type has a table of allowed keys; anything else is a
  * "bad_field" naming the key, so a typo never silently does nothing. Only
  * syntax and ranges are checked here (see sl_protocol.h for what is not).
  * Any thread; no allocation beyond the cJSON tree the message owns.
+ * Cameras are checked with the scene parser's own rules (sl_scene.h) plus
+ * the protocol's range limits, never a second copy of those rules.
  */
 #include "sl_protocol.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+
+#include "core/sl_camera.h"
+#include "sl_params_json.h"
+#include "sl_scene.h"
 
 typedef struct msg_spec {
     const char *name;
@@ -238,6 +244,41 @@ void sl_msg_deinit(sl_msg *msg)
     memset(msg, 0, sizeof *msg);
 }
 
+sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_err *err)
+{
+    int is_orbit = 0;
+    sl_camera cam;
+    sl_orbit orbit;
+    sl_status st = sl_camera_json_parse(camera, &is_orbit, &cam, &orbit, err);
+    if (st != SL_OK)
+        return st;
+    sl_vec3 lo = bounds ? sl_v3(bounds[0][0], bounds[0][1], bounds[0][2]) : sl_v3(-1, -1, -1);
+    sl_vec3 hi = bounds ? sl_v3(bounds[1][0], bounds[1][1], bounds[1][2]) : sl_v3(1, 1, 1);
+    if (is_orbit) {
+        if (fabs(orbit.azimuth_deg) > SL_PROTO_CAMERA_MAX_AZIMUTH)
+            return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.azimuth must be in [-%g, %g] degrees, got %g",
+                              SL_PROTO_CAMERA_MAX_AZIMUTH, SL_PROTO_CAMERA_MAX_AZIMUTH, orbit.azimuth_deg);
+        if (orbit.distance > SL_PROTO_CAMERA_MAX_DISTANCE)
+            return sl_err_set(err, SL_ERR_INVALID,
+                              "camera.orbit.distance must be in (0, %g] bounding-sphere radii, got %g",
+                              SL_PROTO_CAMERA_MAX_DISTANCE, orbit.distance);
+        if ((st = sl_camera_from_orbit(&orbit, lo, hi, &cam, err)) != SL_OK)
+            return st;
+    } else {
+        const double v[6] = {cam.eye.x, cam.eye.y, cam.eye.z, cam.target.x, cam.target.y, cam.target.z};
+        for (int i = 0; i < 6; i++)
+            if (fabs(v[i]) > SL_PROTO_CAMERA_MAX_COORD)
+                return sl_err_set(err, SL_ERR_INVALID, "camera.%s components must be within +-%g, got %g",
+                                  i < 3 ? "eye" : "target", SL_PROTO_CAMERA_MAX_COORD, v[i]);
+    }
+    sl_view view;
+    memset(&view, 0, sizeof view);
+    view.camera = cam;
+    view.width = view.height = 1;
+    view.origin = sl_v3_scale(sl_v3_add(lo, hi), 0.5);
+    return sl_view_init(&view, 0.5 * sl_v3_length(sl_v3_sub(hi, lo)), err);
+}
+
 const char *sl_msg_type_name(sl_msg_type type)
 {
     for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++)
@@ -254,6 +295,150 @@ const char *sl_camera_phase_name(sl_camera_phase phase)
     case SL_PHASE_END: return "end";
     default: return "none";
     }
+}
+
+static char *print_and_free(cJSON *o)
+{
+    char *t = o ? cJSON_PrintUnformatted(o) : NULL;
+    cJSON_Delete(o);
+    return t;
+}
+
+cJSON *sl_msg_stream_json(const sl_stream_settings *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "interactive_scale", s->interactive_scale);
+    cJSON_AddNumberToObject(o, "interactive_quality", s->interactive_quality);
+    cJSON_AddStringToObject(o, "interactive_subsampling", s->interactive_420 ? "420" : "444");
+    cJSON_AddNumberToObject(o, "still_quality", s->still_quality);
+    cJSON_AddStringToObject(o, "still_subsampling", s->still_420 ? "420" : "444");
+    cJSON_AddNumberToObject(o, "still_delay_ms", s->still_delay_ms);
+    return o;
+}
+
+sl_status sl_msg_stream_apply(sl_stream_settings *out, const cJSON *patch, char *field, sl_err *err)
+{
+    sl_stream_settings s = *out;
+    const cJSON *it;
+    field[0] = '\0';
+    cJSON_ArrayForEach(it, patch) {
+        const char *k = it->string ? it->string : "";
+        snprintf(field, SL_PROTO_ID_MAX, "stream.%.48s", k);
+        if (strcmp(k, "interactive_subsampling") == 0 || strcmp(k, "still_subsampling") == 0) {
+            int v = -1;
+            if (cJSON_IsString(it) && strcmp(it->valuestring, "420") == 0)
+                v = 1;
+            else if (cJSON_IsString(it) && strcmp(it->valuestring, "444") == 0)
+                v = 0;
+            if (v < 0)
+                return sl_err_set(err, SL_ERR_INVALID, "%s must be \"420\" or \"444\"", k);
+            *(k[0] == 'i' ? &s.interactive_420 : &s.still_420) = v;
+            continue;
+        }
+        double lo, hi;
+        if (strcmp(k, "interactive_scale") == 0) { lo = 0.1; hi = 1.0; }
+        else if (strcmp(k, "interactive_quality") == 0 || strcmp(k, "still_quality") == 0) { lo = 1; hi = 100; }
+        else if (strcmp(k, "still_delay_ms") == 0) { lo = 0; hi = 10000; }
+        else
+            return sl_err_set(err, SL_ERR_INVALID, "unknown stream setting \"%.48s\"", k);
+        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || it->valuedouble < lo || it->valuedouble > hi ||
+            (strcmp(k, "interactive_scale") != 0 && it->valuedouble != floor(it->valuedouble)))
+            return sl_err_set(err, SL_ERR_INVALID, "%s must be a%s number in [%g, %g]", k,
+                              strcmp(k, "interactive_scale") != 0 ? "n integer" : "", lo, hi);
+        if (strcmp(k, "interactive_scale") == 0) s.interactive_scale = it->valuedouble;
+        else if (strcmp(k, "interactive_quality") == 0) s.interactive_quality = (int)it->valuedouble;
+        else if (strcmp(k, "still_quality") == 0) s.still_quality = (int)it->valuedouble;
+        else s.still_delay_ms = (int)it->valuedouble;
+    }
+    field[0] = '\0';
+    *out = s;
+    return SL_OK;
+}
+
+cJSON *sl_msg_state_json(const sl_msg_state *st)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "version", st->version);
+    cJSON_AddStringToObject(o, "dataset", st->dataset);
+    cJSON_AddStringToObject(o, "technique", st->technique);
+    cJSON_AddItemToObject(o, "params", sl_params_to_json(st->params));
+    cJSON *cam = cJSON_Parse(st->camera_json);
+    cJSON_AddItemToObject(o, "camera", cam ? cam : cJSON_CreateNull());
+    cJSON_AddNumberToObject(o, "camera_seq", st->camera_seq);
+    cJSON_AddNumberToObject(o, "width", st->width);
+    cJSON_AddNumberToObject(o, "height", st->height);
+    cJSON_AddItemToObject(o, "background", cJSON_CreateFloatArray(st->background, 4));
+    cJSON_AddItemToObject(o, "stream", sl_msg_stream_json(st->stream));
+    cJSON_AddNumberToObject(o, "controller", st->controller);
+    cJSON_AddItemToObject(o, "bounds", st->bounds ? cJSON_Duplicate(st->bounds, 1) : cJSON_CreateNull());
+    return o;
+}
+
+char *sl_msg_state_text(uint32_t version, cJSON *patch)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) {
+        cJSON_Delete(patch);
+        return NULL;
+    }
+    cJSON_AddStringToObject(o, "type", "state");
+    cJSON_AddNumberToObject(o, "version", version);
+    cJSON_AddItemToObject(o, "patch", patch ? patch : cJSON_CreateObject());
+    return print_and_free(o);
+}
+
+char *sl_msg_welcome_text(const sl_msg_welcome *w)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "welcome");
+    cJSON_AddNumberToObject(o, "version", SL_PROTO_VERSION);
+    cJSON_AddStringToObject(o, "session", w->session);
+    cJSON_AddStringToObject(o, "token", w->token);
+    cJSON_AddNumberToObject(o, "client", w->client);
+    cJSON_AddStringToObject(o, "role", w->is_controller ? "controller" : "viewer");
+    cJSON_AddItemToObject(o, "state", w->state ? w->state : cJSON_CreateNull());
+    cJSON_AddItemToObject(o, "techniques", w->techniques ? w->techniques : cJSON_CreateArray());
+    cJSON_AddItemToObject(o, "datasets", w->datasets ? w->datasets : cJSON_CreateArray());
+    cJSON *lim = cJSON_AddObjectToObject(o, "limits");
+    cJSON_AddNumberToObject(lim, "max_message", SL_PROTO_MAX_MESSAGE);
+    cJSON_AddNumberToObject(lim, "max_message_before_hello", SL_PROTO_MAX_HELLO);
+    cJSON_AddNumberToObject(lim, "max_size", SL_PROTO_MAX_SIZE);
+    cJSON_AddNumberToObject(lim, "ack_window", SL_PROTO_ACK_WINDOW);
+    cJSON_AddNumberToObject(lim, "max_clients", w->max_clients);
+    cJSON_AddNumberToObject(lim, "grace_s", w->grace_s);
+    return print_and_free(o);
+}
+
+char *sl_msg_list_text(const char *type, const char *key, cJSON *list)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", type);
+    cJSON_AddItemToObject(o, key, list ? list : cJSON_CreateArray());
+    return print_and_free(o);
+}
+
+char *sl_msg_view_saved_text(const char *name)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "view_saved");
+    cJSON_AddStringToObject(o, "name", name);
+    return print_and_free(o);
+}
+
+char *sl_msg_control_request_text(int client)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "control_request");
+    cJSON_AddNumberToObject(o, "client", client);
+    return print_and_free(o);
+}
+
+char *sl_msg_pong_text(long long seq)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "pong");
+    cJSON_AddNumberToObject(o, "seq", (double)seq);
+    return print_and_free(o);
 }
 
 char *sl_msg_error_text(const char *code, const char *message, const char *field)

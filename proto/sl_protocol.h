@@ -1,5 +1,5 @@
 /* sl_protocol.h — the sightline.v1 wire protocol (proto/PROTOCOL.md): client
- * message parsing, server message helpers and the binary frame header.
+ * message parsing, server message serializers and the binary frame header.
  *
  * Parsing checks every field of a client message (type, ranges, unknown
  * keys) and reports the first bad one by name, so the server can answer with
@@ -18,6 +18,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_params.h"
 #include "core/sl_status.h"
 
 #define SL_PROTO_VERSION 1
@@ -91,12 +92,87 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg,
                        char *code, char *field, sl_err *err);
 void sl_msg_deinit(sl_msg *msg);   /* safe on a zeroed or deinitialized msg */
 
+/* Camera limits of the protocol (PROTOCOL.md) on top of scene.md's rules,
+ * so that every accepted camera renders (no overflow to inf on the way). */
+#define SL_PROTO_CAMERA_MAX_DISTANCE 1e6   /* orbit distance, bounding-sphere radii */
+#define SL_PROTO_CAMERA_MAX_AZIMUTH 1e6    /* |orbit azimuth|, degrees */
+#define SL_PROTO_CAMERA_MAX_COORD 1e12     /* |eye|, |target| components, world units */
+
+/* Checks a `camera` object as the render thread will use it: the scene
+ * rules (sl_camera_json_parse: finite numbers, distance > 0, elevation
+ * within SL_ORBIT_MAX_ELEVATION, fov in (0, 180)), the limits above, then
+ * the resolved view (sl_camera_from_orbit, sl_view_init) against
+ * bounds = {lo, hi} of the session's dataset, or the cube [-1, 1]^3 when
+ * bounds is NULL (not loaded yet). SL_ERR_INVALID with a message naming
+ * the field path (camera.orbit.distance ...) and its limit. */
+sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_err *err);
+
 const char *sl_msg_type_name(sl_msg_type type);
 const char *sl_camera_phase_name(sl_camera_phase phase);
 
-/* {"type":"error","code":code,"message":message,"field":field} as a malloc'd
- * string (NULL on allocation failure). field may be NULL or "". */
+/* ---- server -> client messages ----
+ * Every *_text function returns a malloc'd compact JSON string (NULL on
+ * allocation failure); a cJSON argument named "consumed" is owned by the
+ * function from then on, even on failure. */
+
+/* {"type":"error","code":code,"message":message,"field":field}; field may be NULL or "". */
 char *sl_msg_error_text(const char *code, const char *message, const char *field);
+
+/* A session's stream settings (the `stream` object of `set` and state). */
+typedef struct sl_stream_settings {
+    double interactive_scale;      /* 0.5: half size while dragging, 0.1..1 */
+    int interactive_quality;       /* 60, 1..100 */
+    int interactive_420;           /* 1 */
+    int still_quality;             /* 92, 1..100 */
+    int still_420;                 /* 0 */
+    int still_delay_ms;            /* 200, 0..10000 */
+} sl_stream_settings;
+
+#define SL_STREAM_DEFAULTS ((sl_stream_settings){.interactive_scale = 0.5, .interactive_quality = 60, \
+                                                 .interactive_420 = 1, .still_quality = 92, .still_420 = 0, \
+                                                 .still_delay_ms = 200})
+
+cJSON *sl_msg_stream_json(const sl_stream_settings *s);
+/* Applies a `stream` patch to *s, all or nothing. On failure returns
+ * SL_ERR_INVALID, fills err and writes the field ("stream.<key>") to field
+ * (SL_PROTO_ID_MAX bytes); *s is unchanged. */
+sl_status sl_msg_stream_apply(sl_stream_settings *s, const cJSON *patch, char *field, sl_err *err);
+
+/* The state object of welcome and of a full state patch (PROTOCOL.md). */
+typedef struct sl_msg_state {
+    uint32_t version;
+    const char *dataset, *technique;
+    const sl_params *params;
+    const char *camera_json;       /* a validated camera object */
+    uint32_t camera_seq;
+    int width, height;
+    const float *background;       /* 4 floats */
+    const sl_stream_settings *stream;
+    int controller;                /* client id, 0 = nobody */
+    const cJSON *bounds;           /* [[x,y,z],[x,y,z]] or NULL (copied) */
+} sl_msg_state;
+
+cJSON *sl_msg_state_json(const sl_msg_state *st);
+/* {"type":"state","version":v,"patch":patch (consumed)} */
+char *sl_msg_state_text(uint32_t version, cJSON *patch);
+
+/* welcome: what a client needs after hello. */
+typedef struct sl_msg_welcome {
+    const char *session, *token;
+    int client;
+    int is_controller;
+    cJSON *state;                  /* consumed: sl_msg_state_json */
+    cJSON *techniques;             /* consumed: array of technique schemas */
+    cJSON *datasets;               /* consumed: catalog list */
+    int max_clients, grace_s;      /* limits that are server options */
+} sl_msg_welcome;
+
+char *sl_msg_welcome_text(const sl_msg_welcome *w);
+/* {"type":type,key:list (consumed)}: "datasets"/"datasets", "views"/"views". */
+char *sl_msg_list_text(const char *type, const char *key, cJSON *list);
+char *sl_msg_view_saved_text(const char *name);
+char *sl_msg_control_request_text(int client);
+char *sl_msg_pong_text(long long seq);
 
 /* Binary frames (server -> client): a fixed 40-byte little-endian header
  * followed by `payload_bytes` bytes of JPEG (kind 0) or PNG (kind 1). */

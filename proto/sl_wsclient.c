@@ -106,6 +106,13 @@ static sl_status read_bytes(sl_wsclient *c, uint8_t *dst, size_t n, double deadl
 sl_status sl_wsclient_connect(const char *host, int port, const char *path, const char *subprotocol,
                               const char *origin, int timeout_ms, sl_wsclient **out, sl_err *err)
 {
+    return sl_wsclient_connect_host(host, port, NULL, path, subprotocol, origin, timeout_ms, out, err);
+}
+
+sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_header, const char *path,
+                                   const char *subprotocol, const char *origin, int timeout_ms, sl_wsclient **out,
+                                   sl_err *err)
+{
     *out = NULL;
     sl_wsclient *c = calloc(1, sizeof *c);
     if (!c)
@@ -136,12 +143,16 @@ sl_status sl_wsclient_connect(const char *host, int port, const char *path, cons
         free(c);
         return sl_err_set(err, SL_ERR_IO, "cannot connect to %s:%d", host, port);
     }
-    char req[1024];
+    char req[1024], host_value[300];
+    if (host_header)
+        snprintf(host_value, sizeof host_value, "%s", host_header);
+    else
+        snprintf(host_value, sizeof host_value, "%s:%d", host, port);
     int n = snprintf(req, sizeof req,
-                     "GET %s HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                     "GET %s HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
                      "Sec-WebSocket-Protocol: %s\r\n%s%s%s\r\n",
-                     path, host, port, subprotocol, origin ? "Origin: " : "", origin ? origin : "",
+                     path, host_value, subprotocol, origin ? "Origin: " : "", origin ? origin : "",
                      origin ? "\r\n" : "");
     sl_status st = send_all(c, (const uint8_t *)req, (size_t)n, err);
     if (st) {
@@ -199,7 +210,8 @@ void sl_wsclient_destroy(sl_wsclient *c)
     free(c);
 }
 
-sl_status sl_wsclient_send_frame(sl_wsclient *c, int opcode, const uint8_t *data, size_t len, sl_err *err)
+/* Appends one masked frame to buf (which has room for len + 14 bytes); returns its size. */
+static size_t encode_frame(sl_wsclient *c, int opcode, const uint8_t *data, size_t len, uint8_t *buf)
 {
     uint8_t hdr[14];
     size_t h = 0;
@@ -219,13 +231,35 @@ sl_status sl_wsclient_send_frame(sl_wsclient *c, int opcode, const uint8_t *data
     uint8_t mask[4] = {(uint8_t)c->rng, (uint8_t)(c->rng >> 8), (uint8_t)(c->rng >> 16), (uint8_t)(c->rng >> 24)};
     memcpy(hdr + h, mask, 4);
     h += 4;
-    uint8_t *buf = malloc(h + len);
-    if (!buf)
-        return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate a %zu-byte frame", len);
     memcpy(buf, hdr, h);
     for (size_t i = 0; i < len; i++)
         buf[h + i] = data[i] ^ mask[i & 3];
-    sl_status st = send_all(c, buf, h + len, err);
+    return h + len;
+}
+
+sl_status sl_wsclient_send_frame(sl_wsclient *c, int opcode, const uint8_t *data, size_t len, sl_err *err)
+{
+    uint8_t *buf = malloc(len + 14);
+    if (!buf)
+        return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate a %zu-byte frame", len);
+    size_t n = encode_frame(c, opcode, data, len, buf);
+    sl_status st = send_all(c, buf, n, err);
+    free(buf);
+    return st;
+}
+
+sl_status sl_wsclient_send_texts(sl_wsclient *c, const char *const *texts, int count, sl_err *err)
+{
+    size_t total = 0;
+    for (int i = 0; i < count; i++)
+        total += strlen(texts[i]) + 14;
+    uint8_t *buf = malloc(total ? total : 1);
+    if (!buf)
+        return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate %zu bytes of frames", total);
+    size_t n = 0;
+    for (int i = 0; i < count; i++)
+        n += encode_frame(c, 1, (const uint8_t *)texts[i], strlen(texts[i]), buf + n);
+    sl_status st = send_all(c, buf, n, err);
     free(buf);
     return st;
 }

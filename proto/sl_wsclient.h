@@ -26,11 +26,19 @@ typedef enum sl_ws_kind { SL_WS_TEXT = 1, SL_WS_BINARY = 2, SL_WS_CLOSED = 8 } s
  * HTTP status line is in err. */
 sl_status sl_wsclient_connect(const char *host, int port, const char *path, const char *subprotocol,
                               const char *origin, int timeout_ms, sl_wsclient **out, sl_err *err);
+/* The same with an explicit Host header value (tests of the server's Host
+ * check); host_header NULL sends "host:port". */
+sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_header, const char *path,
+                                   const char *subprotocol, const char *origin, int timeout_ms, sl_wsclient **out,
+                                   sl_err *err);
 void sl_wsclient_destroy(sl_wsclient *c);   /* closes; NULL is fine */
 
 sl_status sl_wsclient_send_text(sl_wsclient *c, const char *text, size_t len, sl_err *err);
 /* Sends a frame of any opcode (tests send oversize or binary messages). */
 sl_status sl_wsclient_send_frame(sl_wsclient *c, int opcode, const uint8_t *data, size_t len, sl_err *err);
+/* Sends count text messages in one write, so the server reads them as one
+ * burst (tests of flooding). */
+sl_status sl_wsclient_send_texts(sl_wsclient *c, const char *const *texts, int count, sl_err *err);
 
 /* Receives one whole message that starts within timeout_ms (once started, it
  * has 10 s to complete, so a timeout never splits a message). *data is owned by the

@@ -7,6 +7,10 @@
  * A dataset row records what the catalog needs to list it without loading
  * it: kind, source (generator JSON or absolute path), file size and an
  * FNV-1a 64 checksum, bounds, counts and attribute names. Does not render.
+ * Removal sticks: `remove` leaves a row in `removed`, and the automatic
+ * registration at start (built-ins, <data-dir>/samples) skips those names;
+ * only an explicit add, add-generator, scan or add-builtins brings one back.
+ * Saved views are capped at SL_CATALOG_MAX_VIEWS rows.
  * Used by the lws service thread (server) or the `catalog` CLI, never both
  * on one connection, never from the render thread.
  */
@@ -35,7 +39,12 @@ static const char *schema_sql =
     "CREATE TABLE IF NOT EXISTS sessions("
     " id TEXT PRIMARY KEY, state TEXT NOT NULL,"
     " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')),"
-    " updated TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));";
+    " updated TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
+    "CREATE TABLE IF NOT EXISTS removed("
+    " name TEXT PRIMARY KEY,"
+    " removed TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
+    "CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '2');";
 
 static sl_status db_fail(sqlite3 *db, sl_err *err, const char *what)
 {
@@ -76,6 +85,30 @@ static int name_exists(sqlite3 *db, const char *name)
     sqlite3_stmt *q = NULL;
     int found = 0;
     if (sqlite3_prepare_v2(db, "SELECT 1 FROM datasets WHERE name = ?1", -1, &q, NULL) == SQLITE_OK) {
+        sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+        found = sqlite3_step(q) == SQLITE_ROW;
+    }
+    sqlite3_finalize(q);
+    return found;
+}
+
+/* Runs one statement with a single text parameter; for the tombstone table. */
+static sl_status exec_name(sqlite3 *db, const char *sql, const char *name, sl_err *err)
+{
+    sqlite3_stmt *q = NULL;
+    if (sqlite3_prepare_v2(db, sql, -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(q);
+    sqlite3_finalize(q);
+    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "tombstone");
+}
+
+static int was_removed(sqlite3 *db, const char *name)
+{
+    sqlite3_stmt *q = NULL;
+    int found = 0;
+    if (sqlite3_prepare_v2(db, "SELECT 1 FROM removed WHERE name = ?1", -1, &q, NULL) == SQLITE_OK) {
         sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
         found = sqlite3_step(q) == SQLITE_ROW;
     }
@@ -139,6 +172,10 @@ static sl_status insert_dataset(sqlite3 *db, const char *name, const char *kind,
         if (sqlite3_step(q) != SQLITE_DONE)
             st = sl_err_set(err, SL_ERR_INVALID, "catalog: cannot add \"%s\": %s", name, sqlite3_errmsg(db));
     }
+    /* Every insert is deliberate (explicit, or automatic after checking
+     * was_removed), so the name is no longer removed. */
+    if (st == SL_OK)
+        st = exec_name(db, "DELETE FROM removed WHERE name = ?1", name, err);
     sqlite3_finalize(q);
     free(bounds);
     free(counts);
@@ -146,12 +183,13 @@ static sl_status insert_dataset(sqlite3 *db, const char *name, const char *kind,
     return st;
 }
 
-sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err)
+/* Registers the built-ins that are absent; revive=0 skips removed ones. */
+static sl_status register_builtins(sqlite3 *db, int revive, int *added, sl_err *err)
 {
     int n = 0;
     const sl_builtin_dataset *b = sl_builtin_datasets(&n);
     for (int i = 0; i < n; i++) {
-        if (name_exists(db, b[i].name))
+        if (name_exists(db, b[i].name) || (!revive && was_removed(db, b[i].name)))
             continue;
         /* Built-ins are registered without generating them (some take seconds);
          * bounds and counts are filled in when one is first rendered. */
@@ -170,15 +208,33 @@ sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, in
                                       NULL, err);
         if (st)
             return st;
+        if (added)
+            (*added)++;
     }
+    return SL_OK;
+}
+
+sl_status sl_catalog_add_builtins(sqlite3 *db, int *added, sl_err *err)
+{
+    *added = 0;
+    return register_builtins(db, 1, added, err);
+}
+
+static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
+                          int *added, sl_err *err);
+
+sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err)
+{
+    sl_status st = register_builtins(db, 0, NULL, err);
+    if (st)
+        return st;
     for (int i = 0; i < dir_count; i++) {
         char samples[PATH_MAX];
         snprintf(samples, sizeof samples, "%s/samples", data_dirs[i]);
         struct stat sb;
         if (stat(samples, &sb) == 0 && S_ISDIR(sb.st_mode)) {
             int added = 0;
-            sl_status st = sl_catalog_scan(db, samples, data_dirs, dir_count, &added, err);
-            if (st)
+            if ((st = scan_dir(db, samples, data_dirs, dir_count, 0, &added, err)) != SL_OK)
                 return st;
         }
     }
@@ -284,6 +340,12 @@ static int known_extension(const char *name)
 sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count,
                           int *added, sl_err *err)
 {
+    return scan_dir(db, dir, data_dirs, dir_count, 1, added, err);
+}
+
+static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
+                          int *added, sl_err *err)
+{
     *added = 0;
     char real[PATH_MAX];
     sl_status st = resolve_inside(dir, data_dirs, dir_count, real, err);
@@ -298,7 +360,8 @@ sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_
             continue;
         char path[PATH_MAX];
         struct stat sb;
-        if (snprintf(path, sizeof path, "%s/%s", real, e->d_name) >= (int)sizeof path || stat(path, &sb) != 0 || !S_ISREG(sb.st_mode) || name_exists(db, e->d_name))
+        if (snprintf(path, sizeof path, "%s/%s", real, e->d_name) >= (int)sizeof path || stat(path, &sb) != 0 || !S_ISREG(sb.st_mode) || name_exists(db, e->d_name) ||
+            (!revive && was_removed(db, e->d_name)))
             continue;
         sl_err one = {0};
         if (sl_catalog_add_file(db, path, data_dirs, dir_count, &one) == SL_OK)
@@ -338,7 +401,7 @@ sl_status sl_catalog_remove(sqlite3 *db, const char *name, sl_err *err)
         return db_fail(db, err, "delete");
     if (sqlite3_changes(db) == 0)
         return sl_err_set(err, SL_ERR_INVALID, "catalog: no dataset named \"%s\"", name);
-    return SL_OK;
+    return exec_name(db, "INSERT OR REPLACE INTO removed(name) VALUES(?1)", name, err);
 }
 
 static cJSON *column_json(sqlite3_stmt *q, int col)
@@ -348,7 +411,7 @@ static cJSON *column_json(sqlite3_stmt *q, int col)
     return j ? j : cJSON_CreateNull();
 }
 
-cJSON *sl_catalog_list_json(sqlite3 *db)
+cJSON *sl_catalog_list_json(sqlite3 *db, int with_paths)
 {
     cJSON *arr = cJSON_CreateArray();
     sqlite3_stmt *q = NULL;
@@ -361,8 +424,13 @@ cJSON *sl_catalog_list_json(sqlite3 *db)
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
         cJSON_AddStringToObject(o, "kind", (const char *)sqlite3_column_text(q, 1));
-        if (sqlite3_column_type(q, 2) != SQLITE_NULL)
-            cJSON_AddStringToObject(o, "path", (const char *)sqlite3_column_text(q, 2));
+        if (sqlite3_column_type(q, 2) != SQLITE_NULL) {
+            if (with_paths)
+                cJSON_AddStringToObject(o, "path", (const char *)sqlite3_column_text(q, 2));
+            cJSON_AddStringToObject(o, "source", "file");
+        } else {
+            cJSON_AddStringToObject(o, "source", "generator");
+        }
         if (sqlite3_column_type(q, 3) != SQLITE_NULL)
             cJSON_AddItemToObject(o, "generator", column_json(q, 3));
         cJSON_AddStringToObject(o, "description",
@@ -417,6 +485,21 @@ sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *datase
                                const char *params_json, const char *camera_json, sl_err *err)
 {
     sqlite3_stmt *q = NULL;
+    /* Replacing a view is always allowed; a new name only below the cap. */
+    long long count = 0;
+    int exists = 0;
+    if (sqlite3_prepare_v2(db, "SELECT COUNT(*), SUM(name = ?1) FROM views", -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare count views");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(q) == SQLITE_ROW) {
+        count = sqlite3_column_int64(q, 0);
+        exists = sqlite3_column_int64(q, 1) > 0;
+    }
+    sqlite3_finalize(q);
+    q = NULL;
+    if (!exists && count >= SL_CATALOG_MAX_VIEWS)
+        return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved views (the limit); reuse a name",
+                          SL_CATALOG_MAX_VIEWS);
     if (sqlite3_prepare_v2(db,
                            "INSERT INTO views(name, dataset, technique, params, camera) VALUES(?1, ?2, ?3, ?4, ?5)"
                            " ON CONFLICT(name) DO UPDATE SET dataset = excluded.dataset,"

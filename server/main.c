@@ -3,9 +3,10 @@
  *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH] [--data-dir DIR]...
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
  *                    [--max-sessions N] [--grace S] [--egl-device D]
- *                    [--default-dataset NAME]
- *   sightline-server catalog add PATH | add-generator NAME JSON | list | remove NAME | scan DIR
- *                    [--db PATH] [--data-dir DIR]
+ *                    [--default-dataset NAME] [--hello-timeout S]
+ *   sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
+ *                    | remove NAME | scan DIR | add-builtins
+ * (options may also follow the subcommand).
  *
  * The work is elsewhere (see sl_server.h for the map): this file opens the
  * catalog, starts the render thread (render.c), creates the lws context
@@ -33,7 +34,7 @@
 #define SL_SOURCE_DIR "."
 #endif
 
-static volatile int interrupted;
+static volatile sig_atomic_t interrupted;
 
 static void on_signal(int sig)
 {
@@ -46,9 +47,10 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
             "                        [--allow-origin URL]... [--max-clients N] [--max-sessions N] [--grace SECONDS]\n"
-            "                        [--egl-device software|INDEX] [--default-dataset NAME]\n"
-            "       sightline-server catalog add PATH | add-generator NAME JSON | list | remove NAME | scan DIR\n"
-            "                        [--db PATH] [--data-dir DIR]\n");
+            "                        [--egl-device software|INDEX] [--default-dataset NAME] [--hello-timeout S]\n"
+            "       sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list\n"
+            "                        | remove NAME | scan DIR | add-builtins\n"
+            "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n");
 }
 
 static int dir_exists(const char *p)
@@ -101,7 +103,7 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
             fprintf(stderr, "sightline-server: %s\n", err.message);
             rc = 1;
         }
-        cJSON *list = sl_catalog_list_json(db);
+        cJSON *list = sl_catalog_list_json(db, 1);
         const cJSON *d;
         cJSON_ArrayForEach(d, list) {
             const cJSON *name = cJSON_GetObjectItemCaseSensitive(d, "name");
@@ -128,6 +130,14 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
             fprintf(stderr, "sightline-server: %s\n", err.message);
             rc = 1;
         }
+    } else if (strcmp(cmd, "add-builtins") == 0 && argc == 1) {
+        int added = 0;
+        if (sl_catalog_add_builtins(db, &added, &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        } else {
+            printf("added %d built-in dataset(s)\n", added);
+        }
     } else if (strcmp(cmd, "scan") == 0 && argc == 2) {
         int added = 0;
         if (sl_catalog_scan(db, argv[1], cfg->data_dirs, cfg->data_dir_count, &added, &err) != SL_OK) {
@@ -147,7 +157,7 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
 int main(int argc, char **argv)
 {
     sl_server_config cfg = {.port = 8080, .bind = "127.0.0.1", .max_clients = 64, .max_sessions = 32,
-                            .grace_s = 300};
+                            .grace_s = 300, .hello_timeout_s = 10};
     char db_default[PATH_MAX], web_default[PATH_MAX], data_default[PATH_MAX];
     const char *xdg = getenv("XDG_DATA_HOME"), *home = getenv("HOME");
     if (xdg && xdg[0])
@@ -191,11 +201,15 @@ int main(int argc, char **argv)
             ok = parse_int(v, 1, 10000, &cfg.max_sessions), i++;
         } else if (strcmp(a, "--grace") == 0 && v) {
             ok = parse_int(v, 0, 86400, &cfg.grace_s), i++;
+        } else if (strcmp(a, "--hello-timeout") == 0 && v) {
+            ok = parse_int(v, 1, 3600, &cfg.hello_timeout_s), i++;
         } else if (strcmp(a, "--default-dataset") == 0 && v) {
             cfg.default_dataset = v, i++;
         } else if (strcmp(a, "--egl-device") == 0 && v) {
             cfg.egl_device = v, i++;
-        } else if (a[0] != '-' && (catalog_at || (i == 1 && strcmp(a, "catalog") == 0))) {
+        } else if (a[0] != '-' && (catalog_at || strcmp(a, "catalog") == 0)) {
+            /* The first word that is not an option value must be `catalog`;
+             * options may come before and after it. */
             if (!catalog_at)
                 catalog_at = i;
             else if (npos < 4)

@@ -4,9 +4,12 @@
  * technique, params, camera, size, stream settings), a version bumped on
  * every change, and the newest frame. The creator holds control; viewers
  * who joined with the token see every change but their camera/set/scene/
- * resize/load_view are refused until control moves to them (grant, release
- * or the controller leaving). A session with no clients lives on for the
- * grace period, then is doomed; the render thread frees it with its GL state.
+ * resize/load_view/save_view are refused until control moves to them (grant,
+ * release or the controller leaving). A control request is a flag on the
+ * requester (wants_control), told to the controller once by write_next, so
+ * repeats merge and only a client's own replies fill its reply ring. A
+ * session with no clients lives on for the grace period, then is doomed;
+ * the render thread frees it with its GL state.
  * Flow control: state changes reach each client as one coalesced `state`
  * patch (newest wins), frames as the session's latest frame, and only while
  * the client has fewer than SL_PROTO_ACK_WINDOW unacknowledged frames.
@@ -86,36 +89,15 @@ static void send_error(sl_server *srv, sl_client *c, const char *code, const cha
     sl_client_queue_text(c, sl_msg_error_text(code, message, field));
 }
 
-static cJSON *stream_json(const sl_stream_settings *s)
-{
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddNumberToObject(o, "interactive_scale", s->interactive_scale);
-    cJSON_AddNumberToObject(o, "interactive_quality", s->interactive_quality);
-    cJSON_AddStringToObject(o, "interactive_subsampling", s->interactive_420 ? "420" : "444");
-    cJSON_AddNumberToObject(o, "still_quality", s->still_quality);
-    cJSON_AddStringToObject(o, "still_subsampling", s->still_420 ? "420" : "444");
-    cJSON_AddNumberToObject(o, "still_delay_ms", s->still_delay_ms);
-    return o;
-}
-
+/* The session's state object (sl_msg_state_json); service thread. */
 static cJSON *state_json(const sl_session *s)
 {
     const sl_session_state *st = &s->state;
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddNumberToObject(o, "version", st->version);
-    cJSON_AddStringToObject(o, "dataset", st->dataset);
-    cJSON_AddStringToObject(o, "technique", st->technique);
-    cJSON_AddItemToObject(o, "params", sl_params_to_json(&st->params));
-    cJSON *cam = cJSON_Parse(st->camera_json);
-    cJSON_AddItemToObject(o, "camera", cam ? cam : cJSON_CreateNull());
-    cJSON_AddNumberToObject(o, "camera_seq", st->camera_seq);
-    cJSON_AddNumberToObject(o, "width", st->width);
-    cJSON_AddNumberToObject(o, "height", st->height);
-    cJSON_AddItemToObject(o, "background", cJSON_CreateFloatArray(st->background, 4));
-    cJSON_AddItemToObject(o, "stream", stream_json(&st->stream));
-    cJSON_AddNumberToObject(o, "controller", s->controller);
-    cJSON_AddItemToObject(o, "bounds", s->bounds ? cJSON_Duplicate(s->bounds, 1) : cJSON_CreateNull());
-    return o;
+    sl_msg_state m = {.version = st->version, .dataset = st->dataset, .technique = st->technique,
+                      .params = &st->params, .camera_json = st->camera_json, .camera_seq = st->camera_seq,
+                      .width = st->width, .height = st->height, .background = st->background, .stream = &st->stream,
+                      .controller = s->controller, .bounds = s->bounds};
+    return sl_msg_state_json(&m);
 }
 
 static void persist(sl_server *srv, sl_session *s)
@@ -195,7 +177,7 @@ void sl_session_free(sl_session *s)
 /* The first catalog dataset the technique accepts; fills the state's dataset fields. */
 static sl_status pick_default_dataset(sl_server *srv, const sl_technique *t, sl_session_state *st, sl_err *err)
 {
-    cJSON *list = sl_catalog_list_json(srv->db);
+    cJSON *list = sl_catalog_list_json(srv->db, 0);
     const cJSON *d;
     sl_status rc = sl_err_set(err, SL_ERR_INVALID, "the catalog has no dataset that %s accepts", t->name);
     cJSON_ArrayForEach(d, list) {
@@ -268,8 +250,7 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     st->width = width > 0 ? width : 640;
     st->height = height > 0 ? height : 480;
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
-    st->stream = (sl_stream_settings){.interactive_scale = 0.5, .interactive_quality = 60, .interactive_420 = 1,
-                                      .still_quality = 92, .still_420 = 0, .still_delay_ms = 200};
+    st->stream = SL_STREAM_DEFAULTS;
     s->empty_since_ms = sl_server_now_ms();
     pthread_mutex_lock(&srv->lock);
     s->next = srv->sessions;
@@ -290,25 +271,17 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     if (!s->controller)
         s->controller = c->id;
     c->hello_done = 1;
+    /* Render errors from before the join are history, not news for this client. */
+    pthread_mutex_lock(&srv->lock);
+    c->error_seq = s->error_seq;
+    pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
-    cJSON *w = cJSON_CreateObject();
-    cJSON_AddStringToObject(w, "type", "welcome");
-    cJSON_AddNumberToObject(w, "version", SL_PROTO_VERSION);
-    cJSON_AddStringToObject(w, "session", s->id);
-    cJSON_AddStringToObject(w, "token", s->token);
-    cJSON_AddNumberToObject(w, "client", c->id);
-    cJSON_AddStringToObject(w, "role", s->controller == c->id ? "controller" : "viewer");
-    cJSON_AddItemToObject(w, "state", state_json(s));
-    cJSON_AddItemToObject(w, "techniques", cJSON_Duplicate(srv->techniques_json, 1));
-    cJSON_AddItemToObject(w, "datasets", sl_catalog_list_json(srv->db));
-    cJSON *lim = cJSON_AddObjectToObject(w, "limits");
-    cJSON_AddNumberToObject(lim, "max_message", SL_PROTO_MAX_MESSAGE);
-    cJSON_AddNumberToObject(lim, "max_message_before_hello", SL_PROTO_MAX_HELLO);
-    cJSON_AddNumberToObject(lim, "max_size", SL_PROTO_MAX_SIZE);
-    cJSON_AddNumberToObject(lim, "ack_window", SL_PROTO_ACK_WINDOW);
-    cJSON_AddNumberToObject(lim, "max_clients", srv->cfg.max_clients);
-    cJSON_AddNumberToObject(lim, "grace_s", srv->cfg.grace_s);
-    sl_client_queue_text(c, print_and_free(w));
+    sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
+                        .is_controller = s->controller == c->id, .state = state_json(s),
+                        .techniques = cJSON_Duplicate(srv->techniques_json, 1),
+                        .datasets = sl_catalog_list_json(srv->db, 0), .max_clients = srv->cfg.max_clients,
+                        .grace_s = srv->cfg.grace_s};
+    sl_client_queue_text(c, sl_msg_welcome_text(&w));
     /* A late joiner gets the latest frame at once: write_next sends it. */
     lws_callback_on_writable(c->wsi);
     (void)srv;
@@ -317,6 +290,11 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
 static void set_controller(sl_session *s, int id)
 {
     s->controller = id;
+    /* A client that holds control no longer waits for it; other pending
+     * requests stay and go to the new controller (broadcast_patch wakes it). */
+    sl_client *now = find_client(s, id);
+    if (now)
+        now->wants_control = 0;
     cJSON *p = cJSON_CreateObject();
     cJSON_AddNumberToObject(p, "controller", id);
     broadcast_patch(s, p);
@@ -345,13 +323,22 @@ static int require_control(sl_server *srv, sl_client *c, const char *what)
     return 0;
 }
 
+/* Validates a camera against the session's dataset bounds (when known) and
+ * copies its compact text to out; on failure sends bad_field/camera. The
+ * same check the render thread's resolution makes, so an accepted camera
+ * renders. */
 static int parse_camera(sl_server *srv, sl_client *c, const cJSON *cam, char out[SL_CAMERA_JSON_MAX])
 {
     sl_err err = {0};
-    int is_orbit = 0;
-    sl_camera camera;
-    sl_orbit orbit;
-    if (sl_camera_json_parse(cam, &is_orbit, &camera, &orbit, &err) != SL_OK) {
+    double bounds[2][3];
+    int have_bounds = cJSON_GetArraySize(c->session->bounds) == 2;
+    for (int i = 0; i < 2 && have_bounds; i++)
+        for (int k = 0; k < 3 && have_bounds; k++) {
+            const cJSON *v = cJSON_GetArrayItem(cJSON_GetArrayItem(c->session->bounds, i), k);
+            have_bounds = cJSON_IsNumber(v);
+            bounds[i][k] = have_bounds ? v->valuedouble : 0.0;
+        }
+    if (sl_msg_camera_check(cam, have_bounds ? (const double (*)[3])bounds : NULL, &err) != SL_OK) {
         send_error(srv, c, "bad_field", err.message, "camera");
         return 0;
     }
@@ -395,47 +382,12 @@ static int apply_params(sl_server *srv, sl_client *c, sl_params *params, const c
 
 static int parse_stream(sl_server *srv, sl_client *c, const cJSON *o, sl_stream_settings *out)
 {
-    sl_stream_settings s = *out;
-    const cJSON *it;
-    cJSON_ArrayForEach(it, o) {
-        const char *k = it->string;
-        char field[96];
-        snprintf(field, sizeof field, "stream.%.80s", k);
-        if (strcmp(k, "interactive_subsampling") == 0 || strcmp(k, "still_subsampling") == 0) {
-            int v = -1;
-            if (cJSON_IsString(it) && strcmp(it->valuestring, "420") == 0)
-                v = 1;
-            else if (cJSON_IsString(it) && strcmp(it->valuestring, "444") == 0)
-                v = 0;
-            if (v < 0) {
-                send_error(srv, c, "bad_field", "subsampling must be \"420\" or \"444\"", field);
-                return 0;
-            }
-            *(k[0] == 'i' ? &s.interactive_420 : &s.still_420) = v;
-            continue;
-        }
-        double lo, hi;
-        if (strcmp(k, "interactive_scale") == 0) { lo = 0.1; hi = 1.0; }
-        else if (strcmp(k, "interactive_quality") == 0 || strcmp(k, "still_quality") == 0) { lo = 1; hi = 100; }
-        else if (strcmp(k, "still_delay_ms") == 0) { lo = 0; hi = 10000; }
-        else {
-            send_error(srv, c, "bad_field", "unknown stream setting", field);
-            return 0;
-        }
-        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || it->valuedouble < lo || it->valuedouble > hi ||
-            (strcmp(k, "interactive_scale") != 0 && it->valuedouble != floor(it->valuedouble))) {
-            char msg[128];
-            snprintf(msg, sizeof msg, "%s must be a number in [%g, %g]", k, lo, hi);
-            send_error(srv, c, "bad_field", msg, field);
-            return 0;
-        }
-        if (strcmp(k, "interactive_scale") == 0) s.interactive_scale = it->valuedouble;
-        else if (strcmp(k, "interactive_quality") == 0) s.interactive_quality = (int)it->valuedouble;
-        else if (strcmp(k, "still_quality") == 0) s.still_quality = (int)it->valuedouble;
-        else s.still_delay_ms = (int)it->valuedouble;
-    }
-    *out = s;
-    return 1;
+    char field[SL_PROTO_ID_MAX];
+    sl_err err = {0};
+    if (sl_msg_stream_apply(out, o, field, &err) == SL_OK)
+        return 1;
+    send_error(srv, c, "bad_field", err.message, field);
+    return 0;
 }
 
 /* Switches dataset and/or technique (and optionally params and camera): scene and load_view. */
@@ -550,7 +502,7 @@ static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
     if (m->params)
         cJSON_AddItemToObject(p, "params", sl_params_to_json(&next.params));
     if (m->stream)
-        cJSON_AddItemToObject(p, "stream", stream_json(&next.stream));
+        cJSON_AddItemToObject(p, "stream", sl_msg_stream_json(&next.stream));
     if (m->background)
         cJSON_AddItemToObject(p, "background", cJSON_CreateFloatArray(next.background, 4));
     broadcast_patch(s, p);
@@ -584,13 +536,13 @@ static void on_control(sl_server *srv, sl_client *c, const sl_msg *m)
             set_controller(s, c->id);
             return;
         }
+        /* One pending request per requester, not a message in the controller's
+         * reply ring: repeated requests merge, and a viewer cannot fill the
+         * controller's ring (which would close the controller). */
+        c->wants_control = 1;
         sl_client *ctl = find_client(s, s->controller);
-        if (ctl) {
-            cJSON *r = cJSON_CreateObject();
-            cJSON_AddStringToObject(r, "type", "control_request");
-            cJSON_AddNumberToObject(r, "client", c->id);
-            sl_client_queue_text(ctl, print_and_free(r));
-        }
+        if (ctl)
+            lws_callback_on_writable(ctl->wsi);
         return;
     }
     case SL_CONTROL_GRANT:
@@ -666,32 +618,26 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
             broadcast_patch(s, p);
         }
         break;
-    case SL_MSG_LIST_DATASETS: {
-        cJSON *r = cJSON_CreateObject();
-        cJSON_AddStringToObject(r, "type", "datasets");
-        cJSON_AddItemToObject(r, "datasets", sl_catalog_list_json(srv->db));
-        sl_client_queue_text(c, print_and_free(r));
+    case SL_MSG_LIST_DATASETS:
+        sl_client_queue_text(c, sl_msg_list_text("datasets", "datasets", sl_catalog_list_json(srv->db, 0)));
         break;
-    }
-    case SL_MSG_LIST_VIEWS: {
-        cJSON *r = cJSON_CreateObject();
-        cJSON_AddStringToObject(r, "type", "views");
-        cJSON_AddItemToObject(r, "views", sl_catalog_list_views_json(srv->db));
-        sl_client_queue_text(c, print_and_free(r));
+    case SL_MSG_LIST_VIEWS:
+        sl_client_queue_text(c, sl_msg_list_text("views", "views", sl_catalog_list_views_json(srv->db)));
         break;
-    }
     case SL_MSG_SAVE_VIEW: {
+        /* Views are one catalog-wide namespace that save_view may overwrite,
+         * so only a controller (who can change what the session shows
+         * anyway) may write it. */
+        if (!require_control(srv, c, "save_view"))
+            break;
         char *params = print_and_free(sl_params_to_json(&s->state.params));
         sl_status st = sl_catalog_save_view(srv->db, m.name, s->state.dataset, s->state.technique,
                                             params ? params : "{}", s->state.camera_json, &err);
         free(params);
         if (st) {
-            send_error(srv, c, "internal", err.message, "name");
+            send_error(srv, c, st == SL_ERR_LIMIT ? "limit" : "internal", err.message, "name");
         } else {
-            cJSON *r = cJSON_CreateObject();
-            cJSON_AddStringToObject(r, "type", "view_saved");
-            cJSON_AddStringToObject(r, "name", m.name);
-            sl_client_queue_text(c, print_and_free(r));
+            sl_client_queue_text(c, sl_msg_view_saved_text(m.name));
         }
         break;
     }
@@ -736,13 +682,9 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     case SL_MSG_CONTROL:
         on_control(srv, c, &m);
         break;
-    case SL_MSG_PING: {
-        cJSON *r = cJSON_CreateObject();
-        cJSON_AddStringToObject(r, "type", "pong");
-        cJSON_AddNumberToObject(r, "seq", (double)m.seq);
-        sl_client_queue_text(c, print_and_free(r));
+    case SL_MSG_PING:
+        sl_client_queue_text(c, sl_msg_pong_text(m.seq));
         break;
-    }
     default:
         break;
     }
@@ -805,13 +747,11 @@ void sl_sessions_on_wake(sl_server *srv)
             s->snap_ready = NULL;
             s->snap_ready_count = 0;
         }
-        for (sl_client *c = s->clients; c; c = c->next) {
-            if (c->error_seq != s->error_seq) {
-                c->error_seq = s->error_seq;
-                srv->metrics.errors_sent++;
-                sl_client_queue_text(c, sl_msg_error_text("render_failed", s->error_text, ""));
-            }
-        }
+        /* The session's newest render error is sent by write_next (coalesced:
+         * a client that is behind gets the latest error once, not a backlog). */
+        for (sl_client *c = s->clients; c; c = c->next)
+            if (c->error_seq != s->error_seq)
+                lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
     /* Dataset descriptions from the render thread: taken under the lock, written
@@ -859,6 +799,25 @@ static int write_buf(struct lws *wsi, uint8_t *data, size_t len, enum lws_write_
     return n < (int)len ? -1 : 0;
 }
 
+/* Writes text (consumed) at once and asks for the next writable callback. */
+static int write_text_now(sl_client *c, char *text)
+{
+    if (!text)
+        return -1;
+    size_t len = strlen(text);
+    uint8_t *buf = malloc(LWS_PRE + len);
+    if (!buf) {
+        free(text);
+        return -1;
+    }
+    memcpy(buf + LWS_PRE, text, len);
+    free(text);
+    int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
+    free(buf);
+    lws_callback_on_writable(c->wsi);
+    return rc;
+}
+
 int sl_client_write_next(sl_server *srv, sl_client *c)
 {
     if (c->text_count > 0) {
@@ -887,27 +846,28 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     if (!s)
         return 0;
     if (c->patch) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "type", "state");
-        cJSON_AddNumberToObject(o, "version", c->patch_version);
-        cJSON_AddItemToObject(o, "patch", c->patch);
+        cJSON *patch = c->patch;
         c->patch = NULL;
-        char *text = print_and_free(o);
-        if (!text)
-            return -1;
-        size_t len = strlen(text);
-        uint8_t *buf = malloc(LWS_PRE + len);
-        if (!buf) {
-            free(text);
-            return -1;
-        }
-        memcpy(buf + LWS_PRE, text, len);
-        free(text);
-        int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
-        free(buf);
-        lws_callback_on_writable(c->wsi);
-        return rc;
+        return write_text_now(c, sl_msg_state_text(c->patch_version, patch));
     }
+    if (s->controller == c->id) {
+        for (sl_client *r = s->clients; r; r = r->next) {
+            if (!r->wants_control || r == c)
+                continue;
+            r->wants_control = 0;
+            return write_text_now(c, sl_msg_control_request_text(r->id));
+        }
+    }
+    char *error = NULL;
+    pthread_mutex_lock(&srv->lock);
+    if (c->error_seq != s->error_seq) {
+        c->error_seq = s->error_seq;
+        srv->metrics.errors_sent++;
+        error = sl_msg_error_text("render_failed", s->error_text, "");
+    }
+    pthread_mutex_unlock(&srv->lock);
+    if (error)
+        return write_text_now(c, error);
     if (c->snapshot) {
         sl_frame_buf *f = c->snapshot;
         c->snapshot = NULL;
@@ -939,17 +899,26 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
 void sl_sessions_sweep(sl_server *srv)
 {
     double now = sl_server_now_ms();
-    pthread_mutex_lock(&srv->lock);
-    for (sl_session *s = srv->sessions; s; s = s->next) {
-        if (s->doomed || s->client_count > 0 || now - s->empty_since_ms < srv->cfg.grace_s * 1000.0)
-            continue;
+    /* One expired session per pass under the lock; its catalog row is deleted
+     * after unlocking, so a WAL commit never stalls the render thread. */
+    for (;;) {
+        char id[sizeof srv->sessions->id] = "";
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *s = srv->sessions; s && !id[0]; s = s->next) {
+            if (s->doomed || s->client_count > 0 || now - s->empty_since_ms < srv->cfg.grace_s * 1000.0)
+                continue;
+            memcpy(id, s->id, sizeof id);
+            s->doomed = 1;   /* the render thread may free it from here on */
+            srv->session_count--;
+            pthread_cond_signal(&srv->wake);
+        }
+        pthread_mutex_unlock(&srv->lock);
+        if (!id[0])
+            break;
         sl_err err = {0};
-        sl_catalog_session_remove(srv->db, s->id, &err);
-        s->doomed = 1;
-        srv->session_count--;
-        pthread_cond_signal(&srv->wake);
+        if (sl_catalog_session_remove(srv->db, id, &err) != SL_OK)
+            fprintf(stderr, "sightline-server: %s\n", err.message);
     }
-    pthread_mutex_unlock(&srv->lock);
 }
 
 void sl_sessions_destroy_all(sl_server *srv)

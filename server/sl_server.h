@@ -17,11 +17,17 @@
  * Fields marked "[service]" or "[render]" belong to that thread alone.
  * Nothing is queued without a bound: state is "newest wins", a session keeps
  * one latest frame, a client keeps at most SL_CLIENT_MAX_TEXT replies.
+ * Only a client's own requests go into its reply ring (so only it can fill
+ * it and get closed for it); whatever other clients or the render thread
+ * cause reaches it as coalesced state on the client or session — the state
+ * patch, pending control requests (one flag per requester), the session's
+ * latest render error and latest frame — written when its socket is writable.
  */
 #ifndef SL_SERVER_H
 #define SL_SERVER_H
 
 #include <pthread.h>
+#include <signal.h>
 #include <sqlite3.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -39,10 +45,11 @@ typedef struct sl_dataset sl_dataset;
 
 #define SL_SERVER_MAX_ORIGINS 8
 #define SL_SERVER_MAX_DATA_DIRS 8
-#define SL_CLIENT_MAX_TEXT 32          /* queued replies per client; more closes it */
+#define SL_CLIENT_MAX_TEXT 32          /* queued replies to the client's own requests; more closes it */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_CAMERA_JSON_MAX 1024
 #define SL_SOURCE_MAX 2048
+#define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
 
 typedef struct sl_server_config {
     int port;                      /* 0: any free port (printed on stdout) */
@@ -56,6 +63,7 @@ typedef struct sl_server_config {
     int max_clients;               /* default 64 */
     int max_sessions;              /* default 32 */
     int grace_s;                   /* default 300 */
+    int hello_timeout_s;           /* default 10: seconds from upgrade to hello */
     const char *egl_device;        /* NULL: auto */
     const char *default_dataset;   /* NULL: the first catalog dataset the first technique accepts */
 } sl_server_config;
@@ -89,15 +97,6 @@ sl_status sl_encoder_png(const uint8_t *rgba_top_down, int width, int height, sl
                          double *encode_ms, sl_err *err);
 
 /* ---- sessions (session.c) ---- */
-
-typedef struct sl_stream_settings {
-    double interactive_scale;      /* 0.5: half size while dragging */
-    int interactive_quality;       /* 60 */
-    int interactive_420;           /* 1 */
-    int still_quality;             /* 92 */
-    int still_420;                 /* 0 */
-    int still_delay_ms;            /* 200 */
-} sl_stream_settings;
 
 /* What a session should show: copied whole by the render thread. */
 typedef struct sl_session_state {
@@ -136,7 +135,8 @@ struct sl_client {                  /* [service] */
     uint32_t inflight[SL_PROTO_ACK_WINDOW]; /* sent, unacknowledged frame ids */
     int inflight_count;
     sl_frame_buf *snapshot;         /* PNG waiting to be sent */
-    uint32_t error_seq;             /* render errors already reported */
+    uint32_t error_seq;             /* session error_seq already reported (set at attach) */
+    int wants_control;              /* asked for control; the controller has not been told yet */
     int close_after_send;
     sl_client *next;                /* in session->clients */
 };
@@ -195,6 +195,7 @@ void sl_histogram_add(sl_histogram *h, double ms);
 typedef struct sl_server {
     sl_server_config cfg;
     struct lws_context *lws;
+    int port;                                /* listening port (after sl_ws_create) */
     sqlite3 *db;                             /* [service] */
     pthread_mutex_t lock;
     pthread_cond_t wake;                     /* render thread waits here */
@@ -233,13 +234,17 @@ void sl_render_stop(sl_server *srv);
 /* catalog.c — every query uses bound parameters. */
 sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err);
 void sl_catalog_close(sqlite3 *db);
-/* Registers the built-in generator datasets (when absent) and scans dirs. */
+/* At every start: registers the built-in generator datasets and the files
+ * in <dir>/samples that are absent, except names that were removed. */
 sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err);
+/* Registers every absent built-in, removed or not (`catalog add-builtins`). */
+sl_status sl_catalog_add_builtins(sqlite3 *db, int *added, sl_err *err);
 /* Adds a file; refused when outside every data_dir (after realpath). */
 sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *data_dirs, int dir_count,
                               sl_err *err);
 sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count,
                           int *added, sl_err *err);
+/* Deletes the row and records the name as removed (see init_defaults). */
 sl_status sl_catalog_remove(sqlite3 *db, const char *name, sl_err *err);
 /* Registers a named generator call (validated by generating it once). */
 sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *generator_json, sl_err *err);
@@ -249,11 +254,15 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
 /* Fills bounds/counts/attributes of a row that has none yet (built-ins). */
 sl_status sl_catalog_set_info(sqlite3 *db, const char *name, const char *bounds, const char *counts,
                               const char *attrs, sl_err *err);
-/* JSON array of {name, kind, source, bounds, counts, attributes, ...}. */
-cJSON *sl_catalog_list_json(sqlite3 *db);
+/* JSON array of {name, kind, source ("file"|"generator"), generator?, bounds,
+ * counts, attributes, ...}; the absolute file `path` only with with_paths
+ * (the CLI; clients never see server paths). */
+cJSON *sl_catalog_list_json(sqlite3 *db, int with_paths);
 /* Fills source (generator JSON or path), is_file and kind; SL_ERR_INVALID when unknown. */
 sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t source_size, int *is_file,
                             int *kind, sl_err *err);
+/* Stores or replaces a named view; SL_ERR_LIMIT for a new name when
+ * SL_CATALOG_MAX_VIEWS views exist. */
 sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *dataset, const char *technique,
                                const char *params_json, const char *camera_json, sl_err *err);
 /* *view receives {name, dataset, technique, params, camera} or NULL when absent. */
@@ -270,7 +279,7 @@ char *sl_http_metrics(sl_server *srv);
 
 /* ws.c */
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
-void sl_ws_run(sl_server *srv, volatile int *interrupted);
+void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted);
 void sl_ws_destroy(sl_server *srv);
 
 /* clock.c */

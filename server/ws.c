@@ -1,9 +1,15 @@
 /* ws.c — the libwebsockets side: one context, static files, /healthz, /metrics, /ws.
  *
  * Everything here runs on the lws service thread (the thread that calls
- * sl_ws_run). WebSocket upgrades are accepted only on path /ws with
- * subprotocol sightline.v1 and an Origin that is absent (non-browser
- * clients), equal to the served origin (http://<Host>) or in the allow-list.
+ * sl_ws_run). Every request (HTTP and WebSocket) must name this server in
+ * its Host header: localhost, 127.0.0.1, [::1] or the --bind address with
+ * the listening port (no port only when it is 80), or the host of an
+ * --allow-origin URL; anything else gets 421 (or a refused upgrade). That
+ * stops DNS rebinding: a hostile page whose name resolves to this machine
+ * still sends its own name as Host. WebSocket upgrades are accepted only
+ * on path /ws with subprotocol sightline.v1 and an Origin that is absent
+ * (non-browser clients), equal to the served origin http://<Host> (Host
+ * checked as above) or in the allow-list.
  * Incoming messages are reassembled up to SL_PROTO_MAX_HELLO bytes before
  * hello and SL_PROTO_MAX_MESSAGE after; a larger one closes only that
  * connection with 1008 (policy violation). Writes happen only in
@@ -16,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <libwebsockets.h>
 
@@ -40,14 +47,71 @@ static sl_server *server_of(struct lws *wsi)
     return lws_context_user(lws_get_context(wsi));
 }
 
+/* 1 when host is "name:port" (or "name" with port 80) for the listening port. */
+static int host_is(const char *host, const char *name, int port)
+{
+    size_t n = strlen(name);
+    if (strncasecmp(host, name, n) != 0)
+        return 0;
+    if (host[n] == '\0')
+        return port == 80;
+    char want[16];
+    snprintf(want, sizeof want, ":%d", port);
+    return strcmp(host + n, want) == 0;
+}
+
+/* The authority ("host[:port]") of an allow-listed origin URL such as
+ * "https://viz.example.org" or "http://10.0.0.5:8080". */
+static int host_of_origin(const char *host, const char *origin)
+{
+    const char *p = strstr(origin, "://");
+    if (!p)
+        return 0;
+    p += 3;
+    size_t n = strcspn(p, "/");
+    return n > 0 && strlen(host) == n && strncasecmp(host, p, n) == 0;
+}
+
+static int host_allowed(sl_server *srv, const char *host)
+{
+    static const char *const local[] = {"localhost", "127.0.0.1", "[::1]"};
+    for (size_t i = 0; i < sizeof local / sizeof local[0]; i++)
+        if (host_is(host, local[i], srv->port))
+            return 1;
+    const char *bind = srv->cfg.bind;
+    if (bind && bind[0]) {
+        char name[300];
+        snprintf(name, sizeof name, strchr(bind, ':') ? "[%s]" : "%s", bind);
+        if (host_is(host, name, srv->port))
+            return 1;
+    }
+    for (int i = 0; i < srv->cfg.origin_count; i++)
+        if (host_of_origin(host, srv->cfg.origins[i]))
+            return 1;
+    return 0;
+}
+
+/* Host header check for any request (see the file comment). */
+static int request_host_allowed(sl_server *srv, struct lws *wsi)
+{
+    char host[256];
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0 || !host_allowed(srv, host)) {
+        lwsl_notice("refused request for Host \"%s\"\n", lws_hdr_total_length(wsi, WSI_TOKEN_HOST) > 0 ? host : "");
+        return 0;
+    }
+    return 1;
+}
+
 static int origin_allowed(sl_server *srv, struct lws *wsi)
 {
     char origin[256], host[256], served[300];
+    if (!request_host_allowed(srv, wsi))
+        return 0;
     if (lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) <= 0)
         return 1; /* not a browser: nothing to protect against */
     if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0) {
         snprintf(served, sizeof served, "http://%s", host);
-        if (strcmp(origin, served) == 0)
+        if (strcasecmp(origin, served) == 0)
             return 1;
     }
     for (int i = 0; i < srv->cfg.origin_count; i++)
@@ -55,6 +119,16 @@ static int origin_allowed(sl_server *srv, struct lws *wsi)
             return 1;
     lwsl_notice("refused WebSocket upgrade from origin %s\n", origin);
     return 0;
+}
+
+/* LWS_CALLBACK_FILTER_HTTP_CONNECTION: a plain HTTP request with a foreign
+ * Host gets 421 Misdirected Request and the connection is closed. */
+static int filter_http(sl_server *srv, struct lws *wsi)
+{
+    if (request_host_allowed(srv, wsi))
+        return 0;
+    lws_return_http_status(wsi, 421, "unknown Host");
+    return 1;
 }
 
 static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
@@ -81,8 +155,8 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
         c->wsi = wsi;
         c->id = ++srv->next_client_id;
         pss->client = c;
-        /* hello must come within 10 s (cleared in session.c when it does). */
-        lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, 10);
+        /* hello must come within --hello-timeout s (cleared in session.c when it does). */
+        lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, srv->cfg.hello_timeout_s);
         pthread_mutex_lock(&srv->lock);
         srv->client_count++;
         pthread_mutex_unlock(&srv->lock);
@@ -153,6 +227,8 @@ static int callback_http_extras(struct lws *wsi, enum lws_callback_reasons reaso
     switch (reason) {
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
         return 1; /* WebSocket only on sightline.v1 */
+    case LWS_CALLBACK_FILTER_HTTP_CONNECTION:
+        return filter_http(srv, wsi);
     case LWS_CALLBACK_HTTP: {
         char uri[32] = "";
         lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI);
@@ -213,6 +289,8 @@ static int callback_default(struct lws *wsi, enum lws_callback_reasons reason, v
 {
     if (reason == LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION)
         return 1;
+    if (reason == LWS_CALLBACK_FILTER_HTTP_CONNECTION)
+        return filter_http(server_of(wsi), wsi);
     return lws_callback_http_dummy(wsi, reason, user, in, len);
 }
 
@@ -261,12 +339,13 @@ sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
                           srv->cfg.bind, srv->cfg.port);
     struct lws_vhost *vh = lws_get_vhost_by_name(srv->lws, "default");
     *port = vh ? lws_get_vhost_listen_port(vh) : srv->cfg.port;
+    srv->port = *port;
     sweep_timer.srv = srv;
     lws_sul_schedule(srv->lws, 0, &sweep_timer.sul, sweep_cb, LWS_US_PER_SEC);
     return SL_OK;
 }
 
-void sl_ws_run(sl_server *srv, volatile int *interrupted)
+void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted)
 {
     while (!*interrupted)
         if (lws_service(srv->lws, 0) < 0)

@@ -40,6 +40,7 @@ window.sightline = {
   get frames() { return app.frames; },
   get lastFrame() { return app.lastFrame; },
   get state() { return app.state; },
+  get techniques() { return app.techniques; },
   get clientId() { return app.clientId; },
   get cameraSeq() { return app.seq; },
   get stateVersion() { return app.stateVersion; },
@@ -71,6 +72,7 @@ function refreshRole() {
   $('dataset').disabled = !ctl;
   $('technique').disabled = !ctl;
   $('load-view').disabled = !ctl;
+  $('save-view').disabled = !ctl;
 }
 
 function techniqueByName(name) {
@@ -99,7 +101,7 @@ function fillPickers() {
   const dsSel = $('dataset'), tSel = $('technique');
   dsSel.replaceChildren(...app.datasets.map((d) => {
     const o = new Option(`${d.name} (${d.kind})`, d.name);
-    o.title = d.description || d.path || '';
+    o.title = d.description || (d.source === 'file' ? `file, ${d.file_size ?? '?'} bytes` : 'generated');
     return o;
   }));
   const kind = datasetByName(app.state?.dataset)?.kind;

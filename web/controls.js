@@ -3,7 +3,8 @@
 // description). float/int -> slider + value with unit, bool -> checkbox,
 // enum -> select (colormaps too), vec3 -> three number fields; an int whose
 // values have labels (the dataset's attribute names) -> select. Descriptions
-// become tooltips. Knows nothing about techniques by name.
+// become tooltips; a slider also shows its range and unit ("0 … 1000 world")
+// beside the value and in its tooltip. Knows nothing about techniques by name.
 
 function fmt(v, type) {
   if (type === 'int') return String(Math.round(v));
@@ -73,13 +74,17 @@ export class ParamControls {
         slider.min = sc.min; slider.max = sc.max; slider.step = sc.step;
         const out = document.createElement('output');
         const unit = def.unit ? ` ${def.unit}` : '';
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = `${fmt(def.min, def.type)} … ${fmt(def.max, def.type)}${unit}`;
+        slider.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
         slider.addEventListener('input', () => { out.textContent = fmt(sc.fromSlider(slider.value), def.type) + unit; });
         slider.addEventListener('change', () => {
           let v = sc.fromSlider(slider.value);
           if (def.type === 'int') v = Math.round(v);
           this.onChange(def.name, v);
         });
-        row.append(slider, out);
+        row.append(slider, out, range);
         entry = { def, set: (v) => { slider.value = sc.toSlider(v); out.textContent = fmt(v, def.type) + unit; } };
       } else if (def.type === 'bool') {
         const box = document.createElement('input');

@@ -143,6 +143,23 @@ async function main() {
       return s.name;
     });
     check(changed !== null, 'a slider was generated from the schema');
+    // Every slider shows its schema range and unit beside it.
+    const ranges = await page.evaluate(() => {
+      const schema = window.sightline.techniques.find((t) => t.name === window.sightline.state.technique).params;
+      return [...document.querySelectorAll('#params input[type=range]')].map((s) => {
+        const def = schema.find((d) => d.name === s.name);
+        const shown = s.parentElement.querySelector('small.range')?.textContent || '';
+        return { name: s.name, shown, unit: def.unit || '', min: def.min, max: def.max, type: def.type };
+      });
+    });
+    const fmtNum = (v, type) => {
+      if (type === 'int') return String(Math.round(v));
+      const t = Number(v).toPrecision(4);
+      return t.includes('.') && !t.includes('e') ? t.replace(/0+$/, '').replace(/\.$/, '') : t;
+    };
+    const badRanges = ranges.filter((r) =>
+      r.shown !== `${fmtNum(r.min, r.type)} … ${fmtNum(r.max, r.type)}${r.unit ? ` ${r.unit}` : ''}`);
+    check(ranges.length > 0 && badRanges.length === 0, `sliders show min … max and unit (${JSON.stringify(badRanges.slice(0, 3))})`);
     if (changed) {
       await page.waitForFunction(([name, old]) => window.sightline.state.params[name] !== old,
         [changed, before.v[changed]], { timeout: T });

@@ -5,7 +5,8 @@
 # packages of its own. Docker cannot run here, so this evaluates the two
 # package-list commands as written in the files and compares the results;
 # it also checks the image's required shape (Debian 12, non-root, port 8080,
-# HEALTHCHECK on /healthz). Prints "N passed, N failed".
+# HEALTHCHECK on /healthz) and that .dockerignore keeps build folders,
+# node_modules and data/samples out of the context. Prints "N passed, N failed".
 set -uo pipefail
 root="${SIGHTLINE_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
 df="$root/docker/Dockerfile"
@@ -53,5 +54,12 @@ check 'grep -Eq "^EXPOSE 8080" "$df"' "EXPOSE 8080"
 check 'printf "%s\n" "$joined" | grep -Eq "^HEALTHCHECK .*/healthz"' "HEALTHCHECK on /healthz"
 check 'grep -Eq "^USER [a-z]" "$df" && ! grep -Eq "^USER root" "$df"' "runs as a non-root user"
 check 'grep -q "sightline-server" "$df"' "builds and runs sightline-server"
+# The build context leaves out build folders, npm modules and downloaded samples.
+ign="$root/.dockerignore"
+check '[ -f "$ign" ]' ".dockerignore exists at the context root"
+for pat in 'build\*/' '\*\*/node_modules' 'data/samples'; do
+  check "grep -qx '$pat' \"\$ign\"" ".dockerignore lists $pat"
+done
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -8,6 +8,9 @@
  * refuses an unknown one; add-generator validates its JSON; names with SQL
  * quotes are data, not SQL (bound parameters); the database is in WAL mode
  * (a -wal file exists while the server holds it); bad server arguments exit 2.
+ * Removal sticks: a removed built-in or sample is not registered again by
+ * later starts (`list` runs the same registration as a server start) until
+ * `add-builtins` or `scan` brings it back; options may precede `catalog`.
  * The same server run also checks --max-clients: the third upgrade is refused
  * and a slot frees when a client leaves.
  */
@@ -139,6 +142,55 @@ int main(void)
     SL_CHECK(run(NULL, rm) == 0);
     SL_CHECK(strstr(list(), "vol.nrrd") == NULL && strstr(listing, "second.nrrd") != NULL);
     SL_CHECK(run(NULL, rm) != 0);
+
+    /* A removed built-in stays removed across starts; add-builtins brings it back. */
+    const char *rm_tornado[] = {"catalog", "remove", "tornado", NULL};
+    SL_CHECK(run(NULL, rm_tornado) == 0);
+    SL_CHECK(strstr(list(), "tornado ") == NULL && strstr(listing, "head ") != NULL);
+    SL_CHECK(strstr(list(), "tornado ") == NULL);
+    const char *builtins[] = {"catalog", "add-builtins", NULL};
+    SL_CHECK(run(NULL, builtins) == 0);
+    SL_CHECK(strstr(list(), "tornado ") != NULL);
+
+    /* Samples are registered at start; a removed sample stays removed until a scan. */
+    char samples[400], sample[500];
+    snprintf(samples, sizeof samples, "%s/samples", data);
+    snprintf(sample, sizeof sample, "%s/sample.nrrd", samples);
+    SL_CHECK(mkdir(samples, 0755) == 0 && write_nrrd(sample) == 0);
+    SL_CHECK(strstr(list(), "sample.nrrd") != NULL);
+    const char *rm_sample[] = {"catalog", "remove", "sample.nrrd", NULL};
+    SL_CHECK(run(NULL, rm_sample) == 0);
+    SL_CHECK(strstr(list(), "sample.nrrd") == NULL);
+    SL_CHECK(strstr(list(), "sample.nrrd") == NULL);
+    const char *scan_samples[] = {"catalog", "scan", samples, NULL};
+    SL_CHECK(run(NULL, scan_samples) == 0);
+    SL_CHECK(strstr(list(), "sample.nrrd") != NULL);
+
+    /* Global options before the subcommand. */
+    {
+        char out[400];
+        snprintf(out, sizeof out, "%s/pre.txt", dir);
+        pid_t pid = fork();
+        if (pid == 0) {
+            int fd = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            if (fd >= 0)
+                dup2(fd, 1);
+            execl(exe, exe, "--db", db, "--data-dir", data, "catalog", "list", (char *)NULL);
+            _exit(127);
+        }
+        int status = 0;
+        waitpid(pid, &status, 0);
+        SL_CHECK_MSG(WIFEXITED(status) && WEXITSTATUS(status) == 0, "--db X catalog list exit status %d", status);
+        char text[16384] = "";
+        FILE *pf = fopen(out, "r");
+        size_t n = pf ? fread(text, 1, sizeof text - 1, pf) : 0;
+        text[n] = 0;
+        if (pf)
+            fclose(pf);
+        SL_CHECK(strstr(text, "second.nrrd") != NULL);
+    }
+    const char *stray[] = {"list", "catalog", NULL};
+    SL_CHECK(run(NULL, stray) == 2);
 
     /* WAL mode: the server keeps a -wal file beside the database. */
     char wal[400];

@@ -10,6 +10,11 @@
  * server's resident memory after round 2 is not more than round 1's plus
  * 25% + 32 MiB (no growth per message: state is newest-wins, frames are
  * replaced, queues are bounded); the server exits cleanly.
+ * Phase 2 puts 16 clients in ONE session: the controller sends the 200
+ * camera messages, 15 viewers watch (all drain and ack). Every client must
+ * end with the same newest still frame (seq 200, one frame id for all),
+ * none may be closed, and the server must have sent each rendered frame to
+ * all of them from one encode (frames received <= 16 x frames rendered).
  */
 #include <arpa/inet.h>
 #include <math.h>
@@ -82,6 +87,104 @@ static void *run_worker(void *arg)
     return NULL;
 }
 
+typedef struct viewer {
+    int port;
+    const char *session, *token;
+    pthread_barrier_t *barrier;
+    int ok_join, ok_final, closed, frames;
+    uint32_t final_seq, final_id;
+    int final_interactive;
+    char error[256];
+} viewer;
+
+/* After the last camera message: waits for the newest still, meets the
+ * others, drains briefly and records the newest frame id it has. */
+static void finish(tclient *c, pthread_barrier_t *barrier, int *ok_final, uint32_t *seq, int *interactive,
+                   uint32_t *id)
+{
+    if (tclient_wait_frame(c, MESSAGES, 1, 90000) == 0) {
+        *ok_final = 1;
+        *seq = c->last.h.camera_seq;
+        *interactive = (c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE) != 0;
+    }
+    pthread_barrier_wait(barrier);   /* everyone has the still: nothing new renders */
+    drain(c, 300);
+    *id = c->max_frame_id;
+}
+
+static void *run_viewer(void *arg)
+{
+    viewer *v = arg;
+    tclient c;
+    v->ok_join = tclient_connect(&c, v->port, NULL) == 0 && tclient_hello(&c, v->session, v->token, W, H) == 0;
+    c.auto_ack = 1;
+    if (v->ok_join && tclient_wait_frame(&c, 0, 0, 60000) != 0)
+        snprintf(v->error, sizeof v->error, "no frame at join");
+    pthread_barrier_wait(v->barrier);   /* all joined: the controller starts */
+    finish(&c, v->barrier, &v->ok_final, &v->final_seq, &v->final_interactive, &v->final_id);
+    v->closed = c.closed;
+    v->frames = c.frames;
+    tclient_close(&c);
+    return NULL;
+}
+
+/* Phase 2: one session, the controller on this thread, CLIENTS - 1 viewers. */
+static void shared_session(const harness *h)
+{
+    tclient ctl;
+    if (tclient_connect(&ctl, h->port, NULL) != 0 || tclient_hello(&ctl, NULL, NULL, W, H) != 0) {
+        SL_CHECK(!"shared session created");
+        tclient_close(&ctl);
+        return;
+    }
+    ctl.auto_ack = 1;
+    pthread_barrier_t barrier;
+    pthread_barrier_init(&barrier, NULL, CLIENTS);
+    viewer v[CLIENTS - 1];
+    pthread_t th[CLIENTS - 1];
+    for (int i = 0; i < CLIENTS - 1; i++) {
+        v[i] = (viewer){.port = h->port, .session = ctl.session, .token = ctl.token, .barrier = &barrier};
+        pthread_create(&th[i], NULL, run_viewer, &v[i]);
+    }
+    pthread_barrier_wait(&barrier);
+    for (int i = 1; i <= MESSAGES; i++) {
+        if (tclient_send(&ctl, "{\"type\":\"camera\",\"seq\":%d,\"phase\":\"%s\",\"camera\":{\"orbit\":"
+                               "{\"azimuth\":%.3f,\"elevation\":25,\"distance\":2.5}}}",
+                         i, i == MESSAGES ? "end" : "move", 360.0 * i / MESSAGES))
+            break;
+        drain(&ctl, 4);
+    }
+    int ctl_final = 0, ctl_interactive = 0;
+    uint32_t ctl_seq = 0, ctl_id = 0;
+    finish(&ctl, &barrier, &ctl_final, &ctl_seq, &ctl_interactive, &ctl_id);
+    int joined = 0, final_ok = 0, same_id = 0, closed = ctl.closed, frames = ctl.frames;
+    for (int i = 0; i < CLIENTS - 1; i++) {
+        pthread_join(th[i], NULL);
+        joined += v[i].ok_join;
+        final_ok += v[i].ok_final && v[i].final_seq == MESSAGES && !v[i].final_interactive;
+        same_id += v[i].final_id == ctl_id;
+        closed += v[i].closed;
+        frames += v[i].frames;
+        if (v[i].error[0])
+            fprintf(stderr, "viewer %d: %s\n", i, v[i].error);
+    }
+    uint32_t rendered = ctl.max_frame_id;
+    printf("shared session: 1 controller + %d viewers, %d camera messages; %u frames rendered, %d received\n",
+           CLIENTS - 1, MESSAGES, rendered, frames);
+    SL_CHECK_MSG(joined == CLIENTS - 1, "%d of %d viewers joined", joined, CLIENTS - 1);
+    SL_CHECK_MSG(ctl_final && ctl_seq == MESSAGES && !ctl_interactive, "controller final frame seq %u", ctl_seq);
+    SL_CHECK_MSG(final_ok == CLIENTS - 1, "%d of %d viewers ended with the newest still frame", final_ok,
+                 CLIENTS - 1);
+    SL_CHECK_MSG(same_id == CLIENTS - 1, "%d of %d viewers ended on the controller's frame id %u", same_id,
+                 CLIENTS - 1, ctl_id);
+    SL_CHECK_MSG(closed == 0, "%d clients of the shared session were closed", closed);
+    SL_CHECK_MSG(rendered < MESSAGES, "%u frames for %d camera messages: not coalesced", rendered, MESSAGES);
+    SL_CHECK_MSG(frames <= CLIENTS * (int)rendered, "%d frames received > %d clients x %u rendered", frames, CLIENTS,
+                 rendered);
+    pthread_barrier_destroy(&barrier);
+    tclient_close(&ctl);
+}
+
 static long rss_kib(pid_t pid)
 {
     char path[64], line[256];
@@ -107,7 +210,8 @@ static double healthz_ms(int port)
             close(fd);
         return 1e9;
     }
-    const char *req = "GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+    char req[128];
+    snprintf(req, sizeof req, "GET /healthz HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n", port);
     char buf[1024];
     size_t len = 0;
     if (write(fd, req, strlen(req)) < 0) {
@@ -186,6 +290,7 @@ int main(void)
     SL_CHECK_MSG(worst < 3000, "worst /healthz latency under load %.0f ms", worst);
     SL_CHECK_MSG(rss1 > 0 && rss2 > 0 && rss2 <= rss1 + rss1 / 4 + 32 * 1024, "RSS %ld -> %ld KiB", rss1, rss2);
     pthread_barrier_destroy(&barrier);
+    shared_session(&h);
     int status = harness_stop(&h);
     SL_CHECK_MSG(status == 0, "server exit status %d", status);
     SL_TEST_END();

@@ -152,6 +152,102 @@ static int wait_version(tclient *c, uint32_t version)
     return -1;
 }
 
+/* Waits for a state patch carrying `key`; returns the message (caller frees) or NULL. */
+static cJSON *wait_patch_key(tclient *c, const char *key)
+{
+    double deadline = harness_now_ms() + T;
+    while (harness_now_ms() < deadline) {
+        cJSON *m = tclient_wait_type(c, "state", T);
+        if (!m)
+            return NULL;
+        if (cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), key))
+            return m;
+        cJSON_Delete(m);
+    }
+    return NULL;
+}
+
+/* Waits for a patch that sets the controller; returns it (-1 on timeout). */
+static int wait_controller(tclient *c)
+{
+    cJSON *m = wait_patch_key(c, "controller");
+    int id = m ? cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "controller")->valueint
+               : -1;
+    cJSON_Delete(m);
+    return id;
+}
+
+/* Sends msg from a viewer and expects not_controller; the state must not change. */
+static int refused_for_viewer(tclient *c, const char *msg)
+{
+    if (tclient_send(c, "%s", msg))
+        return 0;
+    cJSON *e = tclient_wait_type(c, "error", T);
+    int ok = error_is(e, "not_controller", NULL);
+    cJSON_Delete(e);
+    if (!ok)
+        fprintf(stderr, "viewer message not refused: %s\n", msg);
+    return ok;
+}
+
+/* Waits for a text of the given type or an error; returns it (caller frees) or NULL. */
+static cJSON *wait_reply(tclient *c, const char *type)
+{
+    double deadline = harness_now_ms() + T;
+    while (harness_now_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(c, T, &j);
+        if (r == 1 && (strcmp(json_type(j), type) == 0 || strcmp(json_type(j), "error") == 0))
+            return j;
+        cJSON_Delete(j);
+        if (r == 0)
+            return NULL;
+    }
+    return NULL;
+}
+
+/* Upgrade with an explicit Host header and Origin; 0 when the server answers 101. */
+static int upgrade_with(int port, const char *host, const char *origin)
+{
+    sl_wsclient *ws = NULL;
+    sl_err err = {0};
+    sl_status st = sl_wsclient_connect_host("127.0.0.1", port, host, "/ws", SL_PROTO_SUBPROTOCOL, origin, 10000, &ws,
+                                            &err);
+    sl_wsclient_destroy(ws);
+    return st == SL_OK ? 0 : -1;
+}
+
+/* GET / with an explicit Host header; returns the HTTP status. */
+static int http_status_with_host(int port, const char *host)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    char req[256], out[512] = "";
+    int n = snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n\r\n", host);
+    size_t len = 0;
+    if (write(fd, req, (size_t)n) == n) {
+        double deadline = harness_now_ms() + 5000;
+        while (len < 12 && harness_now_ms() < deadline) {
+            struct pollfd pfd = {.fd = fd, .events = POLLIN};
+            if (poll(&pfd, 1, 200) <= 0)
+                continue;
+            ssize_t r = read(fd, out + len, sizeof out - 1 - len);
+            if (r <= 0)
+                break;
+            len += (size_t)r;
+        }
+    }
+    close(fd);
+    out[len] = 0;
+    return len >= 12 ? atoi(out + 9) : 0;
+}
+
 static double metric(const char *text, const char *name)
 {
     char key[128];
@@ -188,7 +284,7 @@ static int pick_numeric_param(const cJSON *welcome, char *name, size_t size, dou
 int main(void)
 {
     harness h;
-    const char *extra[] = {"--grace", "2", NULL};
+    const char *extra[] = {"--grace", "2", "--hello-timeout", "2", "--allow-origin", "https://viz.example.org", NULL};
     if (harness_start(&h, extra) != 0) {
         SL_CHECK(!"server started");
         harness_stop(&h);
@@ -290,6 +386,53 @@ int main(void)
     cJSON_Delete(e);
     SL_CHECK(still_usable(&a, 2));
 
+    /* --- cameras that would not render are refused on arrival, naming the field;
+     *     the state does not change and no client gets render_failed --- */
+    {
+        SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":60,\"camera\":{\"orbit\":{\"azimuth\":10,\"elevation\":5,\"distance\":2}}}") == 0);
+        cJSON *m = wait_patch_key(&a, "camera_seq");
+        uint32_t v0 = m ? (uint32_t)cJSON_GetObjectItemCaseSensitive(m, "version")->valuedouble : 0;
+        cJSON_Delete(m);
+        static const char *const bad[][2] = {
+            {"{\"orbit\":{\"azimuth\":1e308,\"elevation\":0,\"distance\":2}}", "camera.orbit.azimuth"},
+            {"{\"orbit\":{\"azimuth\":0,\"elevation\":0,\"distance\":1e300}}", "camera.orbit.distance"},
+            {"{\"orbit\":{\"azimuth\":0,\"elevation\":91,\"distance\":2}}", "camera.orbit.elevation"},
+            {"{\"eye\":[1e300,0,0],\"target\":[0,0,0]}", "camera.eye"},
+            {"{\"eye\":[0,0,1],\"target\":[0,0,0],\"up\":[0,0,1]}", "camera.up"},
+            {"{\"fov_y\":180,\"orbit\":{\"azimuth\":0,\"elevation\":0,\"distance\":2}}", "camera.fov_y"},
+        };
+        for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+            SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":%d,\"camera\":%s}", 61 + i, bad[i][0]) == 0);
+            e = tclient_wait_type(&a, "error", T);
+            const cJSON *msg = cJSON_GetObjectItemCaseSensitive(e, "message");
+            SL_CHECK(error_is(e, "bad_field", "camera"));
+            SL_CHECK_MSG(cJSON_IsString(msg) && strstr(msg->valuestring, bad[i][1]), "camera %s: message %s", bad[i][0],
+                         cJSON_IsString(msg) ? msg->valuestring : "(none)");
+            cJSON_Delete(e);
+        }
+        SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":70,\"camera\":{\"orbit\":{\"azimuth\":15,\"elevation\":5,\"distance\":2}}}") == 0);
+        m = wait_patch_key(&a, "camera_seq");
+        uint32_t v1 = m ? (uint32_t)cJSON_GetObjectItemCaseSensitive(m, "version")->valuedouble : 0;
+        const cJSON *seq = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "camera_seq");
+        SL_CHECK_MSG(v0 > 0 && v1 == v0 + 1, "state version %u -> %u across refused cameras", v0, v1);
+        SL_CHECK(seq && seq->valueint == 70);
+        cJSON_Delete(m);
+        int got = 0, render_failed = 0;
+        double deadline = harness_now_ms() + T;
+        while (!got && harness_now_ms() < deadline) {
+            cJSON *j = NULL;
+            int rr = tclient_next(&a, T, &j);
+            if (rr == 1 && strcmp(json_type(j), "error") == 0)
+                render_failed++;
+            cJSON_Delete(j);
+            if (rr == 2 && a.last.h.camera_seq == 70 && !(a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE))
+                got = 1;
+            if (rr == 0)
+                break;
+        }
+        SL_CHECK_MSG(got && render_failed == 0, "frame for seq 70: %d, errors meanwhile: %d", got, render_failed);
+    }
+
     /* A valid parameter change is broadcast as a state patch and renders a new frame. */
     uint32_t before = a.max_frame_id;
     double newv = pint ? plo : fmin(phi, plo + 0.01);
@@ -351,13 +494,46 @@ int main(void)
     cJSON_Delete(e);
     tclient_close(&bad);
 
-    /* --- Origin check --- */
+    /* --- Origin and Host checks (DNS rebinding: a hostile name that resolves
+     *     here sends its own name as Host and as Origin; both must be refused) --- */
     tclient o;
     SL_CHECK(tclient_connect(&o, h.port, "http://evil.example") != 0);
-    char origin[64];
+    char origin[64], hostport[64];
     snprintf(origin, sizeof origin, "http://127.0.0.1:%d", h.port);
     SL_CHECK(tclient_connect(&o, h.port, origin) == 0);
     tclient_close(&o);
+    snprintf(hostport, sizeof hostport, "evil.example:%d", h.port);
+    snprintf(origin, sizeof origin, "http://evil.example:%d", h.port);
+    SL_CHECK_MSG(upgrade_with(h.port, hostport, origin) != 0, "rebinding pair Host+Origin %s accepted", hostport);
+    SL_CHECK(upgrade_with(h.port, hostport, NULL) != 0);
+    SL_CHECK(http_status_with_host(h.port, hostport) == 421);
+    snprintf(hostport, sizeof hostport, "localhost:%d", h.port);
+    snprintf(origin, sizeof origin, "http://localhost:%d", h.port);
+    SL_CHECK(upgrade_with(h.port, hostport, origin) == 0);       /* the browser on http://localhost:PORT */
+    SL_CHECK(http_status_with_host(h.port, hostport) == 200);
+    snprintf(hostport, sizeof hostport, "[::1]:%d", h.port);
+    SL_CHECK(upgrade_with(h.port, hostport, NULL) == 0);
+    snprintf(hostport, sizeof hostport, "localhost:%d", h.port + 1); /* right name, wrong port */
+    SL_CHECK(upgrade_with(h.port, hostport, NULL) != 0);
+    SL_CHECK(upgrade_with(h.port, "viz.example.org", "https://viz.example.org") == 0); /* --allow-origin */
+    SL_CHECK(upgrade_with(h.port, "viz.example.org", "http://evil.example") != 0);
+
+    /* --- hello timeout (--hello-timeout 2 here): a silent connection is closed
+     *     after 2 s (lws checks timeouts once a second), one that said hello is not --- */
+    {
+        tclient silent;
+        SL_CHECK(tclient_connect(&silent, h.port, NULL) == 0);
+        double t0 = harness_now_ms();
+        int rr;
+        do {
+            rr = tclient_next(&silent, 6000, NULL);
+        } while (rr > 0);
+        double waited = harness_now_ms() - t0;
+        SL_CHECK_MSG(silent.closed && waited >= 1900 && waited < 4500, "silent client closed=%d after %.0f ms",
+                     silent.closed, waited);
+        tclient_close(&silent);
+        SL_CHECK(still_usable(&a, 6));   /* a said hello long ago and is still connected */
+    }
 
     /* --- two clients, one session: same changes, same frame ids; control --- */
     tclient b;
@@ -384,6 +560,39 @@ int main(void)
     e = tclient_wait_type(&b, "error", T);
     SL_CHECK(error_is(e, "not_controller", NULL));
     cJSON_Delete(e);
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"set\",\"params\":{}}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"set\",\"stream\":{\"still_quality\":50}}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"scene\",\"dataset\":\"tiny\"}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"resize\",\"width\":64,\"height\":64}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"load_view\",\"name\":\"front\"}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"save_view\",\"name\":\"by-viewer\"}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"control\",\"action\":\"release\"}"));
+    SL_CHECK(refused_for_viewer(&b, "{\"type\":\"control\",\"action\":\"grant\",\"client\":1}"));
+
+    /* --- a viewer floods control requests (100 in one TCP write): the requests
+     *     merge into one pending request per requester, so the controller is
+     *     never closed for a full reply queue and keeps control --- */
+    {
+        const char *flood[100];
+        for (int i = 0; i < 100; i++)
+            flood[i] = "{\"type\":\"control\",\"action\":\"request\"}";
+        SL_CHECK(sl_wsclient_send_texts(b.ws, flood, 100, &b.err) == SL_OK);
+        int notes = 0, wrong = 0;
+        double until = harness_now_ms() + 1500;
+        while (harness_now_ms() < until && !a.closed) {
+            cJSON *j = NULL;
+            if (tclient_next(&a, 100, &j) == 1 && strcmp(json_type(j), "control_request") == 0) {
+                notes++;
+                wrong += cJSON_GetObjectItemCaseSensitive(j, "client")->valueint != b.client_id;
+            }
+            cJSON_Delete(j);
+        }
+        SL_CHECK_MSG(!a.closed, "the controller was closed by a viewer's flood (close code %d)", a.close_code);
+        SL_CHECK_MSG(notes >= 1 && notes <= 10 && !wrong, "%d control_request messages (%d wrong) for 100 merged requests",
+                     notes, wrong);
+        SL_CHECK(still_usable(&a, 7));
+        SL_CHECK(refused_for_viewer(&b, "{\"type\":\"camera\",\"seq\":11,\"camera\":{\"orbit\":{\"azimuth\":1,\"elevation\":1,\"distance\":2}}}"));
+    }
     SL_CHECK(tclient_send(&b, "{\"type\":\"control\",\"action\":\"request\"}") == 0);
     cJSON *req = tclient_wait_type(&a, "control_request", T);
     SL_CHECK(req && cJSON_GetObjectItemCaseSensitive(req, "client")->valueint == b.client_id);
@@ -503,6 +712,30 @@ int main(void)
     e = tclient_wait_type(&a, "error", T);
     SL_CHECK(error_is(e, "not_found", "name"));
     cJSON_Delete(e);
+    /* The catalog holds at most 256 views (PROTOCOL.md): new names fail with
+     * `limit` beyond that, replacing an existing one still works. One at a
+     * time, since pipelining 256 replies would overflow our own reply ring. */
+    {
+        int saved = 1; /* "front" */
+        cJSON *refusal = NULL;
+        for (int i = 0; i < 300 && !refusal; i++) {
+            SL_CHECK(tclient_send(&a, "{\"type\":\"save_view\",\"name\":\"cap-%d\"}", i) == 0);
+            cJSON *m = wait_reply(&a, "view_saved");
+            if (!m)
+                break;
+            if (strcmp(json_type(m), "error") == 0)
+                refusal = m;
+            else
+                saved++, cJSON_Delete(m);
+        }
+        SL_CHECK_MSG(saved == 256, "%d views saved before the limit (256)", saved);
+        SL_CHECK(error_is(refusal, "limit", "name"));
+        cJSON_Delete(refusal);
+        SL_CHECK(tclient_send(&a, "{\"type\":\"save_view\",\"name\":\"cap-3\"}") == 0);
+        cJSON *m = wait_reply(&a, "view_saved");
+        SL_CHECK(m && strcmp(json_type(m), "view_saved") == 0);
+        cJSON_Delete(m);
+    }
 
     /* --- list_datasets and scene switch --- */
     SL_CHECK(tclient_send(&a, "{\"type\":\"list_datasets\"}") == 0);
@@ -538,6 +771,21 @@ int main(void)
         }
         char *add[] = {h.exe, "catalog", "add", objpath, "--db", h.db, "--data-dir", datadir, NULL};
         SL_CHECK(harness_run_wait(add) == 0);
+        /* Clients learn that it is a file, never the server's path to it. */
+        SL_CHECK(tclient_send(&a, "{\"type\":\"list_datasets\"}") == 0);
+        cJSON *fl = tclient_wait_type(&a, "datasets", T);
+        int file_entry = 0, paths = 0;
+        cJSON_ArrayForEach(dsj, cJSON_GetObjectItemCaseSensitive(fl, "datasets")) {
+            const cJSON *src = cJSON_GetObjectItemCaseSensitive(dsj, "source");
+            paths += cJSON_GetObjectItemCaseSensitive(dsj, "path") != NULL;
+            file_entry |= strcmp(cJSON_GetObjectItemCaseSensitive(dsj, "name")->valuestring, "lines.obj") == 0 &&
+                          cJSON_IsString(src) && strcmp(src->valuestring, "file") == 0;
+        }
+        char *fl_text = fl ? cJSON_PrintUnformatted(fl) : NULL;
+        SL_CHECK_MSG(file_entry && paths == 0 && fl_text && !strstr(fl_text, h.dir), "datasets list leaks paths: %.300s",
+                     fl_text ? fl_text : "(none)");
+        free(fl_text);
+        cJSON_Delete(fl);
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
         int saw_dataset = 0, saw_bounds = 0;
         uint32_t version = 0;
@@ -617,6 +865,44 @@ int main(void)
     SL_CHECK(metric(body, "sightline_sessions") >= 1);
     SL_CHECK(strstr(body, "sightline_encode_ms_bucket{le=\"+Inf\"}") != NULL);
     SL_CHECK(http_get(h.port, "/no-such-file", body, sizeof body) == 404);
+
+    /* --- a late joiner is not told about a render error from before it joined
+     *     (the vanished file above failed, then the session rendered again) --- */
+    tclient late;
+    SL_CHECK(tclient_connect(&late, h.port, NULL) == 0);
+    SL_CHECK(tclient_hello(&late, a.session, a.token, W, H) == 0);
+    late.auto_ack = 1;
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":80,\"camera\":{\"orbit\":{\"azimuth\":33,\"elevation\":3,\"distance\":2}}}") == 0);
+    {
+        int got = 0, errors = 0;
+        double deadline = harness_now_ms() + T;
+        while (!got && harness_now_ms() < deadline) {
+            cJSON *j = NULL;
+            int rr = tclient_next(&late, T, &j);
+            if (rr == 1 && strcmp(json_type(j), "error") == 0)
+                errors++;
+            cJSON_Delete(j);
+            got = rr == 2 && late.last.h.camera_seq >= 80 && !(late.last.h.flags & SL_FRAME_FLAG_INTERACTIVE);
+            if (rr == 0)
+                break;
+        }
+        SL_CHECK_MSG(got && errors == 0, "late joiner: frame %d, stale errors %d", got, errors);
+    }
+
+    /* --- control release, then the controller leaving: control passes to the
+     *     longest-connected remaining client each time --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"control\",\"action\":\"release\"}") == 0);
+    SL_CHECK_MSG(wait_controller(&late) == b.client_id, "after release control went elsewhere than b");
+    SL_CHECK(wait_controller(&a) == b.client_id);
+    SL_CHECK(refused_for_viewer(&a, "{\"type\":\"camera\",\"seq\":81,\"camera\":{\"orbit\":{\"azimuth\":1,\"elevation\":1,\"distance\":2}}}"));
+    SL_CHECK(tclient_send(&b, "{\"type\":\"camera\",\"seq\":82,\"camera\":{\"orbit\":{\"azimuth\":44,\"elevation\":4,\"distance\":2}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&late, 82, 1, T) == 0);
+    tclient_close(&b);
+    SL_CHECK_MSG(wait_controller(&late) == a.client_id, "after the controller left, control did not pass to a");
+    SL_CHECK(wait_controller(&a) == a.client_id);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":83,\"camera\":{\"orbit\":{\"azimuth\":55,\"elevation\":5,\"distance\":2}}}") == 0);
+    SL_CHECK(tclient_wait_frame(&late, 83, 1, T) == 0);
+    tclient_close(&late);
 
     /* --- grace period: rejoin after all clients left, then expiry --- */
     char sid[64], tok[64];
