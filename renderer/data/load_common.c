@@ -14,6 +14,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -110,6 +111,79 @@ void sl_load_convert(void *dst, sl_voxel_type dst_type, const uint8_t *src, sl_s
             break;
         }
     }
+}
+
+sl_status sl_load_orient_volume(sl_dataset *ds, const double axes[3][3], const double origin[3], int *applied,
+                                sl_err *err)
+{
+    *applied = 0;
+    sl_volume *v = &ds->volume;
+    int perm[3], sign[3], used[3] = {0, 0, 0};
+    double len[3];
+    for (int k = 0; k < 3; k++) {
+        const double *a = axes[k];
+        double norm = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        if (!(norm > 0.0) || !isfinite(norm))
+            return SL_OK;
+        int m = 0;
+        for (int c = 1; c < 3; c++)
+            if (fabs(a[c]) > fabs(a[m]))
+                m = c;
+        for (int c = 0; c < 3; c++)
+            if (c != m && fabs(a[c]) > 1e-6 * norm)
+                return SL_OK; /* oblique */
+        if (used[m])
+            return SL_OK; /* two storage axes along one world axis */
+        used[m] = 1;
+        perm[k] = m;
+        sign[k] = a[m] < 0.0 ? -1 : 1;
+        len[k] = fabs(a[m]);
+    }
+    int dims[3];
+    double spacing[3], o[3];
+    for (int k = 0; k < 3; k++) {
+        int m = perm[k];
+        dims[m] = v->dims[k];
+        spacing[m] = len[k];
+        o[m] = origin[m] - (sign[k] < 0 ? (double)(v->dims[k] - 1) * len[k] : 0.0);
+    }
+    int identity = 1;
+    for (int k = 0; k < 3; k++)
+        identity &= perm[k] == k && sign[k] > 0;
+    if (!identity) {
+        size_t elem = sl_voxel_type_size(v->type) * (size_t)v->components;
+        size_t total = (size_t)v->dims[0] * (size_t)v->dims[1] * (size_t)v->dims[2];
+        uint8_t *dst = malloc(total * elem);
+        if (!dst)
+            return sl_err_set(err, SL_ERR_NOMEM, "out of memory for %zu voxels", total);
+        const uint8_t *src = v->data;
+        /* Destination stride of each source axis, and where source index 0 lands. */
+        size_t dstride[3] = {1, (size_t)dims[0], (size_t)dims[0] * (size_t)dims[1]};
+        ptrdiff_t step[3];
+        size_t base = 0;
+        for (int k = 0; k < 3; k++) {
+            size_t st = dstride[perm[k]];
+            step[k] = sign[k] > 0 ? (ptrdiff_t)st : -(ptrdiff_t)st;
+            if (sign[k] < 0)
+                base += (size_t)(v->dims[k] - 1) * st;
+        }
+        size_t i = 0;
+        for (int z = 0; z < v->dims[2]; z++)
+            for (int y = 0; y < v->dims[1]; y++) {
+                size_t d = (size_t)((ptrdiff_t)base + (ptrdiff_t)z * step[2] + (ptrdiff_t)y * step[1]);
+                for (int x = 0; x < v->dims[0]; x++, i++, d = (size_t)((ptrdiff_t)d + step[0]))
+                    memcpy(dst + d * elem, src + i * elem, elem);
+            }
+        free(v->data);
+        v->data = dst;
+    }
+    for (int c = 0; c < 3; c++) {
+        v->dims[c] = dims[c];
+        v->spacing[c] = spacing[c];
+    }
+    ds->origin = sl_v3(o[0], o[1], o[2]);
+    *applied = 1;
+    return SL_OK;
 }
 
 const char *sl_load_display_name(const char *path)

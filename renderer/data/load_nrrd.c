@@ -3,15 +3,24 @@
  *
  * Reads: type (8/16-bit ints kept, s8 -> s16, 32-bit ints and double -> f32),
  * dimension 3 (scalar) or 4 with a first axis of size 3 (vector field, f32),
- * sizes, spacings or space directions (vector length = spacing; axis rotation
- * and sign are not kept), space origin, endian (little when absent), encoding
- * raw / gzip / ascii, data file, line skip, byte skip (-1 only with raw).
+ * sizes, spacings (absolute values), space directions, space origin, endian
+ * (little when absent), encoding raw / gzip / ascii, data file, line skip,
+ * byte skip (-1 only with raw; for a data file it means "the last bytes",
+ * read by seeking, and line skip is then not checked).
+ * Space directions along world axes in any order and sign (LPS data, axes
+ * stored z-first) are honoured: the voxels are permuted / mirrored so every
+ * world position is kept (sl_load_orient_volume). Oblique (rotated)
+ * directions are not: their lengths become the spacing along the storage
+ * axes and their rotation and sign are dropped. World coordinates are the
+ * file's own space (LPS stays LPS; no conversion to RAS).
  * Does not read: bzip2 / hex encodings, multi-file "data file" forms (LIST,
  * patterns), block or 64-bit types, > 4 axes. Unknown fields and key:=value
  * pairs are ignored. Any thread; no GL.
  * Invariants: binary data must hold exactly the bytes sizes x type imply; no
  * voxel memory before that is known (gzip output is capped at the expected
- * size); ascii data needs >= 1 byte per value before allocation.
+ * size); ascii data needs >= 1 byte per value before allocation. A data
+ * file is never read past what the header can use (data_region_bound), so
+ * a link to /dev/zero or a huge file behind a tiny .nhdr fails at once.
  */
 #include "load_common.h"
 
@@ -25,6 +34,11 @@
 
 #define NRRD_MAX_AXES 16
 #define NRRD_LINE_MAX 4096
+/* Bytes a "line skip" may pass over in a data file whose size the header
+ * does not fix, and bytes an ascii value may take (128 characters plus a
+ * separator): the bounds on what is read for a detached data file. */
+#define NRRD_LINE_SKIP_MAX_BYTES (1024u * 1024u)
+#define NRRD_ASCII_MAX_BYTES_PER_VALUE 129u
 
 enum { ENC_NONE, ENC_RAW, ENC_GZIP, ENC_ASCII };
 enum { END_NONE, END_LITTLE, END_BIG };
@@ -388,6 +402,72 @@ static sl_status decode_ascii(const uint8_t *p, size_t avail, sl_src_type type, 
     return SL_OK;
 }
 
+/* Values the header's sizes describe (components included), or 0 when
+ * they are missing or out of range (the loader will say why). */
+static unsigned long long header_values(const nrrd_header *h)
+{
+    if (!(h->seen & F_SIZES) || !(h->seen & F_TYPE) || h->n_sizes < 1)
+        return 0;
+    unsigned long long values = 1;
+    for (int a = 0; a < h->n_sizes; a++) {
+        if (h->sizes[a] < 1 || h->sizes[a] > INT_MAX)
+            return 0;
+        values *= (unsigned long long)h->sizes[a];
+        if (values > SL_MAX_VOXELS)
+            return 0;
+    }
+    return values;
+}
+
+/* The most bytes the data region (after the header, or the data file) can
+ * take for this header: exact for raw data at a known byte skip (the
+ * region must be exactly that long), a bound for gzip (the compressed
+ * stream of skip + needed bytes), ascii (129 bytes a value) and line skip
+ * (1 MiB of skipped lines); UINT64_MAX when byte skip is -1 (the data is at
+ * the end, so all of it is read). */
+static uint64_t data_region_bound(const nrrd_header *h, unsigned long long values)
+{
+    uint64_t needed = (uint64_t)values * sl_src_type_size(h->type);
+    uint64_t skip = h->byte_skip > 0 ? (uint64_t)h->byte_skip : 0;
+    uint64_t lines = h->line_skip > 0 ? NRRD_LINE_SKIP_MAX_BYTES : 0;
+    if (h->byte_skip < 0)
+        return UINT64_MAX;
+    if (skip > SL_MAX_FILE_BYTES)
+        skip = SL_MAX_FILE_BYTES; /* the loader refuses it later */
+    switch (h->encoding) {
+    case ENC_GZIP: return lines + sl_load_gzip_input_bound(skip + needed);
+    case ENC_ASCII: return lines + skip + (uint64_t)values * NRRD_ASCII_MAX_BYTES_PER_VALUE;
+    default: return lines + skip + needed;
+    }
+}
+
+uint64_t sl_load_nrrd_content_size(const uint8_t *head, size_t n, int complete)
+{
+    nrrd_header *h = calloc(1, sizeof *h);
+    if (!h)
+        return UINT64_MAX;
+    sl_err err = {0};
+    uint64_t total;
+    if (parse_header(head, n, "(probe)", h, &err) != SL_OK)
+        total = n; /* refused from the header alone */
+    else if (!h->blank_line)
+        total = complete ? n : 0; /* a detached header is all header; else read on */
+    else if (h->seen & F_DATAFILE)
+        total = h->data_offset; /* anything after the blank line is not read */
+    else {
+        unsigned long long values = header_values(h);
+        uint64_t bound = values ? data_region_bound(h, values) : 0;
+        if (!values)
+            total = h->data_offset;
+        else if (bound == UINT64_MAX || bound > UINT64_MAX - h->data_offset - 1)
+            total = UINT64_MAX;
+        else
+            total = h->data_offset + bound + 1; /* + 1: the loader sees a file that is too long */
+    }
+    free(h);
+    return total;
+}
+
 sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err)
 {
     *out = NULL;
@@ -450,6 +530,7 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
         }
     }
     double spacing[3] = {1.0, 1.0, 1.0};
+    double axes[3][3];
     if (h->seen & F_DIRECTIONS) {
         if (h->n_dirs != h->dimension) {
             st = sl_err_set(err, SL_ERR_FORMAT, "%s: field 'space directions' has %d entries, field 'dimension' is %d",
@@ -466,6 +547,7 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
                 goto fail;
             }
             spacing[c] = len;
+            memcpy(axes[c], d, sizeof axes[c]);
         }
     } else if (h->seen & F_SPACINGS) {
         if (h->n_spacings != h->dimension) {
@@ -494,15 +576,40 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
     /* The bytes holding the data: attached after the blank line, or the data file. */
     const uint8_t *p;
     size_t avail;
+    size_t tsize = sl_src_type_size(h->type);
+    size_t n = (size_t)values;
+    size_t needed = n * tsize;
+    if (h->byte_skip == -1 && h->encoding != ENC_RAW) {
+        st = sl_err_set(err, SL_ERR_FORMAT, "%s: field 'byte skip' is -1, allowed only with encoding raw", name);
+        goto fail;
+    }
+    int tail = 0; /* the data file's last `needed` bytes were read: no skipping */
     if (h->seen & F_DATAFILE) {
         char resolved[PATH_MAX];
         st = sl_load_resolve_sibling(path, h->data_file, "data file", resolved, sizeof resolved, err);
         if (st != SL_OK)
             goto fail;
-        size_t file_size;
-        st = sl_load_read_raw(resolved, SL_MAX_FILE_BYTES, &file_bytes, &file_size, err);
+        size_t file_size = needed;
+        if (h->byte_skip == -1) {
+            /* Data at the end: seek there (a regular file only), whatever comes before. */
+            st = sl_load_read_tail(resolved, needed, &file_bytes, err);
+            tail = 1;
+        } else {
+            /* Never read more than the header can use: a data file that is a
+             * link to /dev/zero or a huge file costs the header's size. */
+            uint64_t bound = data_region_bound(h, values);
+            if (bound > SL_MAX_FILE_BYTES)
+                bound = SL_MAX_FILE_BYTES;
+            st = sl_load_read_raw(resolved, bound, &file_bytes, &file_size, err);
+            if (st == SL_ERR_LIMIT)
+                st = sl_err_set(err, SL_ERR_FORMAT,
+                                "%s: field 'data file': %s holds more than the %llu bytes fields 'sizes', 'type', "
+                                "'encoding', 'byte skip' and 'line skip' allow",
+                                name, resolved, (unsigned long long)bound);
+        }
         if (st != SL_OK) {
-            sl_err_prefix(err, "%s: field 'data file'", name);
+            if (st != SL_ERR_FORMAT || tail)
+                sl_err_prefix(err, "%s: field 'data file'", name);
             goto fail;
         }
         p = file_bytes;
@@ -515,7 +622,7 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
                         name);
         goto fail;
     }
-    for (long long k = 0; k < h->line_skip; k++) {
+    for (long long k = 0; k < h->line_skip && !tail; k++) {
         const uint8_t *nl = avail ? memchr(p, '\n', avail) : NULL;
         if (!nl) {
             st = sl_err_set(err, SL_ERR_FORMAT, "%s: field 'line skip' is %lld, the data has only %lld lines", name,
@@ -526,13 +633,6 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
         p = nl + 1;
     }
 
-    size_t tsize = sl_src_type_size(h->type);
-    size_t n = (size_t)values;
-    size_t needed = n * tsize;
-    if (h->byte_skip == -1 && h->encoding != ENC_RAW) {
-        st = sl_err_set(err, SL_ERR_FORMAT, "%s: field 'byte skip' is -1, allowed only with encoding raw", name);
-        goto fail;
-    }
     if (h->encoding == ENC_GZIP) {
         size_t inflated_size;
         uint64_t want = (uint64_t)needed + (uint64_t)h->byte_skip;
@@ -555,8 +655,8 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
         p = inflated + h->byte_skip;
         avail = needed;
     } else {
-        size_t skip = (size_t)h->byte_skip;
-        if (h->byte_skip == -1)
+        size_t skip = tail ? 0 : (size_t)h->byte_skip;
+        if (h->byte_skip == -1 && !tail)
             skip = avail >= needed ? avail - needed : 0;
         if (h->byte_skip >= 0 && (unsigned long long)h->byte_skip > avail) {
             st = sl_err_set(err, SL_ERR_FORMAT, "%s: field 'byte skip' is %lld, the data has only %zu bytes", name,
@@ -600,9 +700,20 @@ sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_da
         sl_load_convert(ds->volume.data, target, p, h->type, tsize > 1 && big != sl_load_host_big_endian(), n, 0, 1.0,
                         0.0);
     }
-    for (int c = 0; c < 3; c++)
-        ds->volume.spacing[c] = spacing[c];
-    ds->origin = sl_v3(h->origin[0], h->origin[1], h->origin[2]);
+    int oriented = 0;
+    if (h->seen & F_DIRECTIONS) {
+        st = sl_load_orient_volume(ds, (const double(*)[3])axes, h->origin, &oriented, err);
+        if (st != SL_OK) {
+            sl_err_prefix(err, "%s", name);
+            goto fail;
+        }
+    }
+    if (!oriented) {
+        /* spacings, or oblique directions: vector lengths along the storage axes. */
+        for (int c = 0; c < 3; c++)
+            ds->volume.spacing[c] = spacing[c];
+        ds->origin = sl_v3(h->origin[0], h->origin[1], h->origin[2]);
+    }
     st = sl_dataset_finish_volume(ds, err);
     if (st != SL_OK) {
         sl_err_prefix(err, "%s", name);

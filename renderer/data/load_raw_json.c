@@ -4,14 +4,22 @@
  *    "spacing": [sx, sy, sz], "origin": [ox, oy, oz],
  *    "endian": "little|big", "components": 1|3}
  *
- * raw, dims and type are required; spacing defaults to 1, origin to 0,
- * endian to little, components to 1 (3 = interleaved vector field, stored
- * as f32). The raw file is resolved beside the JSON (sl_load_resolve_sibling:
- * no escapes) and must hold exactly dims x components x type bytes; a name
- * ending in ".gz" is gunzipped first. Unknown keys are ignored.
+ * Keys (case-sensitive; these seven only):
+ *   raw        required  file name, resolved beside the JSON (no "..", an
+ *                        absolute name must lie in the JSON's folder);
+ *                        a name ending in ".gz" is gunzipped
+ *   dims       required  voxels along x, y, z (whole numbers >= 1), x fastest
+ *   type       required  sample type: u8, u16, s16 or f32
+ *   spacing    optional  world units between voxel centres, > 0 (default 1 1 1)
+ *   origin     optional  world position of voxel (0,0,0) (default 0 0 0)
+ *   endian     optional  "little" (default) or "big"
+ *   components optional  1 (default) or 3 (interleaved vector field, f32)
+ * Any other key is an error naming it, so a typo ("endianness") cannot
+ * silently give the default. The raw file must hold exactly dims x
+ * components x type bytes (inflated, for ".gz").
  * Does not read any other layout (planar components, padding, headers).
  * Any thread; no GL. Invariant: the raw file is never read past the size
- * the JSON describes.
+ * the JSON describes (a ".gz" file past sl_load_gzip_input_bound of it).
  */
 #include "load_common.h"
 
@@ -49,6 +57,24 @@ sl_status sl_load_raw_json(const uint8_t *data, size_t size, const char *path, s
     if (!root || !cJSON_IsObject(root)) {
         st = sl_err_set(err, SL_ERR_FORMAT, "%s: not a JSON object", name);
         goto fail;
+    }
+    static const char *const keys[] = {"raw", "dims", "type", "spacing", "origin", "endian", "components"};
+    for (const cJSON *item = root->child; item; item = item->next) {
+        size_t k = 0;
+        while (k < sizeof keys / sizeof keys[0] && strcmp(item->string, keys[k]) != 0)
+            k++;
+        if (k == sizeof keys / sizeof keys[0]) {
+            st = sl_err_set(err, SL_ERR_FORMAT,
+                            "%s: unknown key '%.64s' (the keys are raw, dims, type, spacing, origin, endian, "
+                            "components)",
+                            name, item->string);
+            goto fail;
+        }
+        for (const cJSON *other = root->child; other != item; other = other->next)
+            if (strcmp(other->string, item->string) == 0) {
+                st = sl_err_set(err, SL_ERR_FORMAT, "%s: key '%s' appears twice", name, item->string);
+                goto fail;
+            }
     }
     const cJSON *raw_item = cJSON_GetObjectItemCaseSensitive(root, "raw");
     if (!cJSON_IsString(raw_item) || !raw_item->valuestring[0]) {
@@ -134,10 +160,14 @@ sl_status sl_load_raw_json(const uint8_t *data, size_t size, const char *path, s
         goto fail;
     size_t len = strlen(resolved), raw_size = 0;
     int gz = len > 3 && strcmp(resolved + len - 3, ".gz") == 0;
-    st = sl_load_read_raw(resolved, gz ? SL_MAX_FILE_BYTES : needed, &raw, &raw_size, err);
+    uint64_t limit = gz ? sl_load_gzip_input_bound(needed) : needed;
+    st = sl_load_read_raw(resolved, limit, &raw, &raw_size, err);
     if (st == SL_ERR_LIMIT) {
         st = sl_err_set(err, SL_ERR_FORMAT,
-                        "%s: field 'raw': %s is larger than the %zu bytes fields 'dims', 'type' and 'components' give",
+                        gz ? "%s: field 'raw': %s is larger than a gzip stream of the %zu bytes fields 'dims', 'type' "
+                             "and 'components' give can be"
+                           : "%s: field 'raw': %s is larger than the %zu bytes fields 'dims', 'type' and "
+                             "'components' give",
                         name, resolved, needed);
         goto fail;
     }

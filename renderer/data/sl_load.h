@@ -9,7 +9,18 @@
  *
  * `path` is the file's path (used in messages and to resolve detached data
  * files such as NRRD .nhdr "data file:" or a raw volume's JSON sidecar); it
- * may be NULL, in which case detached data is refused.
+ * may be NULL, in which case detached data is refused. A detached data file
+ * is read only as far as its header can use (a link to /dev/zero behind a
+ * tiny .nhdr fails at once).
+ *
+ * Volume orientation: NRRD space directions and NIfTI sform/qform along
+ * world axes (any order, either sign: LPS data) are honoured by permuting /
+ * mirroring the voxels; oblique (rotated) ones are not (axis-aligned, see
+ * load_nrrd.c, load_nifti.c).
+ *
+ * Raw + JSON sidecar keys (load_raw_json.c; any other key is an error):
+ * raw, dims, type (u8 u16 s16 f32) required; spacing, origin, endian
+ * ("little"/"big"), components (1 or 3) optional.
  */
 #ifndef SL_LOAD_H
 #define SL_LOAD_H
@@ -52,7 +63,9 @@ sl_status sl_gunzip(const uint8_t *data, size_t size, uint64_t limit, uint8_t **
 
 /* Picks the loader from the file name (.trk .tck .vtk .obj .nrrd .nhdr .nii
  * .nii.gz .json), reads the file and loads it. The dataset's name is the
- * file's base name. */
+ * file's base name. NIfTI and NRRD files are read (and inflated) only as
+ * far as their header says; other gzipped files may inflate to at most
+ * max(64 MiB, 64 x their compressed size) (SL_ERR_LIMIT beyond). */
 sl_status sl_load_file(const char *path, sl_dataset **out, sl_err *err);
 
 #endif

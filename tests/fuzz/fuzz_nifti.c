@@ -4,15 +4,21 @@
  * On success the dataset must be a consistent volume (dims >= 1 within
  * SL_MAX_VOXELS, 1 or 3 components, value range ordered) and every voxel is
  * read so ASan sees the whole array; on failure *out must stay NULL and the
- * message be non-empty. Seed corpus: tests/fuzz/corpus/nifti/. Single-threaded.
+ * message be non-empty. The content-size probe of sl_load_file is driven
+ * on the same bytes. Seed corpus: tests/fuzz/corpus/nifti/. Single-threaded.
  */
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "data/load_common.h"
 #include "data/sl_load.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    /* The content-size probe sl_load_file uses: with all bytes present it
+     * must decide (0, "show me more", only for an empty file). */
+    if (sl_load_nifti_content_size(data, size, 1) == 0 && size > 0)
+        abort();
     sl_dataset *ds = NULL;
     sl_err err = {0};
     sl_status st = sl_load_nifti(data, size, NULL, &ds, &err);

@@ -781,9 +781,163 @@ static void test_info_tool(void)
     free(out);
 }
 
+/* ------------------------------------------------ pinned fingerprints */
+
+/* Cross-machine determinism. Counts and the line structure (FNV-1a of the
+ * offsets) must match exactly. Float values come from libm (sin, cos, exp),
+ * whose last bit may differ between libm versions and CPUs (and an FMA
+ * could be fused on another architecture), so for each channel two sums are
+ * pinned instead of the bytes: the plain sum and an order-sensitive
+ * weighted sum (weights 1 + (i mod 13) / 13), each compared within 1e-5 of
+ * the channel's sum of |x|. A 1-ulp libm difference moves them by ~1e-7 of
+ * that scale; a changed formula, seed, order or count moves them by far
+ * more. Regenerate the table with SL_PRINT_FINGERPRINTS=1 (prints it) only
+ * when a generator is changed on purpose. */
+typedef struct fingerprint {
+    uint64_t count_a, count_b;  /* lines, vertices; or voxels, components */
+    uint64_t structure;         /* FNV-1a of line_offsets; or of dims + type */
+    double sums[4][3];          /* channels x (sum, weighted sum, sum |x|) */
+} fingerprint;
+
+enum { FP_POSITIONS, FP_RADII, FP_ATTRIBUTES, FP_TANGENTS }; /* volumes: FP_POSITIONS holds the voxel values */
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const uint8_t *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+static void fp_add(double sums[3], size_t i, double x)
+{
+    sums[0] += x;
+    sums[1] += x * (1.0 + (double)(i % 13) / 13.0);
+    sums[2] += fabs(x);
+}
+
+static void fingerprint_of(const sl_dataset *ds, fingerprint *fp)
+{
+    memset(fp, 0, sizeof *fp);
+    uint64_t h = 0xcbf29ce484222325ull;
+    if (ds->kind == SL_DATASET_LINES) {
+        const sl_lines *l = &ds->lines;
+        fp->count_a = l->line_count;
+        fp->count_b = l->vertex_count;
+        fp->structure = fnv1a(h, l->line_offsets, (l->line_count + 1) * sizeof *l->line_offsets);
+        const double o[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
+        for (size_t i = 0; i < 3 * l->vertex_count; i++)
+            fp_add(fp->sums[FP_POSITIONS], i, o[i % 3] + (double)l->positions[i]);
+        for (size_t i = 0; l->radii && i < l->vertex_count; i++)
+            fp_add(fp->sums[FP_RADII], i, l->radii[i]);
+        size_t k = 0;
+        for (int a = 0; a < l->attribute_count; a++)
+            for (size_t i = 0; i < l->vertex_count; i++)
+                fp_add(fp->sums[FP_ATTRIBUTES], k++, l->attributes[a].values[i]);
+        for (int a = 0; a < l->line_attribute_count; a++)
+            for (size_t i = 0; i < l->line_count; i++)
+                fp_add(fp->sums[FP_ATTRIBUTES], k++, l->line_attributes[a].values[i]);
+        for (size_t i = 0; l->tangents && i < 3 * l->vertex_count; i++)
+            fp_add(fp->sums[FP_TANGENTS], i, l->tangents[i]);
+        return;
+    }
+    const sl_volume *v = &ds->volume;
+    fp->count_a = (uint64_t)v->dims[0] * (uint64_t)v->dims[1] * (uint64_t)v->dims[2];
+    fp->count_b = (uint64_t)v->components;
+    int32_t shape[5] = {v->dims[0], v->dims[1], v->dims[2], v->components, (int32_t)v->type};
+    fp->structure = fnv1a(h, shape, sizeof shape);
+    size_t i = 0;
+    for (int z = 0; z < v->dims[2]; z++)
+        for (int y = 0; y < v->dims[1]; y++)
+            for (int x = 0; x < v->dims[0]; x++)
+                for (int c = 0; c < v->components; c++, i++)
+                    fp_add(fp->sums[FP_POSITIONS], i, sl_volume_value(v, (size_t)x, (size_t)y, (size_t)z, c));
+    const double geo[9] = {ds->origin.x, ds->origin.y, ds->origin.z, v->spacing[0], v->spacing[1], v->spacing[2],
+                           ds->bounds_max.x, ds->bounds_max.y, ds->bounds_max.z};
+    for (size_t g = 0; g < 9; g++)
+        fp_add(fp->sums[FP_RADII], g, geo[g]);
+}
+
+static void test_fingerprints(void)
+{
+    static const struct { const char *call; fingerprint fp; } pinned[] = {
+        /* SL_PRINT_FINGERPRINTS=1 output (x86-64, Debian 12 glibc 2.36, clang). */
+    {"{\"generator\":\"tornado\",\"lines\":12,\"points\":40,\"seed\":3}",
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{719.96560938144103, 1052.5344542675259, 726.44823130453005}, {0, 0, 0}, {89.861844252794981, 131.14633124092438, 89.861844252794981}, {-7.5544770321612305, -11.328233461377078, 119.58155572996111}}}},
+    {"{\"generator\":\"abc\",\"lines\":12,\"points\":40,\"seed\":3}",
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{4402.1141907572746, 6429.4883923209636, 4671.4461830258369}, {0, 0, 0}, {1233.585008263588, 1803.0614530902631, 1233.585008263588}, {154.46864795940928, 225.0093947214861, 1860.010295356391}}}},
+    {"{\"generator\":\"bundle\",\"lines\":12,\"points\":40,\"seed\":3}",
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{106.74300057906657, 155.84213819985183, 624.44715165067464}, {0, 0, 0}, {1004.4982829913497, 1467.5604803149515, 1004.4982829913497}, {0, 0, 0}}}},
+    {"{\"generator\":\"furball\",\"segments\":2000,\"seed\":3}",
+     {22u, 2022u, 0x4405a83ab945811eull, {{-37.133226229809225, -54.776307078579578, 2012.9445473989472}, {0, 0, 0}, {1264.8359995484352, 1852.9864606516282, 1264.8359995484352}, {0, 0, 0}}}},
+    {"{\"generator\":\"hotroom\",\"lines\":200,\"seed\":3}",
+     {200u, 686u, 0x3ed736e9b7c4939dull, {{3636.4620711244643, 5311.3955915481492, 3636.4620711244643}, {54.04782940261066, 79.797361513743056, 54.04782940261066}, {15807.136465698481, 23091.225588784735, 15807.136465698481}, {92.990609086977202, 138.91184507710312, 791.37388523835398}}}},
+    {"{\"generator\":\"marschner_lobb\",\"size\":12,\"noise\":0.1,\"seed\":3}",
+     {1728u, 1u, 0xd143def6ecbf59cbull, {{861.74810269557929, 1258.0309063051918, 864.52593155986688}, {0.54545454545454497, 2.0979020979020984, 6.545454545454545}, {0, 0, 0}, {0, 0, 0}}}},
+    {"{\"generator\":\"torus\",\"size\":12,\"noise\":0.1,\"seed\":3}",
+     {1728u, 1u, 0xd143def6ecbf59cbull, {{843.7492492251331, 1232.8549426402255, 857.36787907441612}, {0.54545454545454497, 2.0979020979020984, 6.545454545454545}, {0, 0, 0}, {0, 0, 0}}}},
+    {"{\"generator\":\"head\",\"size\":12,\"noise\":0.5,\"seed\":3}",
+     {1728u, 1u, 0x914e86e64053e0a9ull, {{436699, 636569.69230769132, 436699}, {60, 230.7692307692308, 720}, {0, 0, 0}, {0, 0, 0}}}},
+    };
+    static const char *const calls[] = {
+        "{\"generator\":\"tornado\",\"lines\":12,\"points\":40,\"seed\":3}",
+        "{\"generator\":\"abc\",\"lines\":12,\"points\":40,\"seed\":3}",
+        "{\"generator\":\"bundle\",\"lines\":12,\"points\":40,\"seed\":3}",
+        "{\"generator\":\"furball\",\"segments\":2000,\"seed\":3}",
+        "{\"generator\":\"hotroom\",\"lines\":200,\"seed\":3}",
+        "{\"generator\":\"marschner_lobb\",\"size\":12,\"noise\":0.1,\"seed\":3}",
+        "{\"generator\":\"torus\",\"size\":12,\"noise\":0.1,\"seed\":3}",
+        "{\"generator\":\"head\",\"size\":12,\"noise\":0.5,\"seed\":3}",
+    };
+    const char *print = getenv("SL_PRINT_FINGERPRINTS");
+    size_t n_calls = sizeof calls / sizeof calls[0];
+    SL_CHECK_MSG(print || sizeof pinned / sizeof pinned[0] == n_calls, "%zu pinned fingerprints for %zu calls",
+                 sizeof pinned / sizeof pinned[0], n_calls);
+    static const char *const channel[4] = {"positions/values", "radii/geometry", "attributes", "tangents"};
+    for (size_t k = 0; k < n_calls; k++) {
+        sl_dataset *ds = gen(calls[k]);
+        if (!ds)
+            continue;
+        fingerprint fp;
+        fingerprint_of(ds, &fp);
+        sl_dataset_destroy(ds);
+        if (print) {
+            /* C string literal of the call, then the fingerprint as an initializer. */
+            printf("    {\"");
+            for (const char *c = calls[k]; *c; c++)
+                printf(*c == '"' ? "\\\"" : "%c", *c);
+            printf("\",\n     {%lluu, %lluu, 0x%016llxull, {", (unsigned long long)fp.count_a,
+                   (unsigned long long)fp.count_b, (unsigned long long)fp.structure);
+            for (int c = 0; c < 4; c++)
+                printf("{%.17g, %.17g, %.17g}%s", fp.sums[c][0], fp.sums[c][1], fp.sums[c][2], c < 3 ? ", " : "");
+            printf("}}},\n");
+            continue;
+        }
+        if (k >= sizeof pinned / sizeof pinned[0])
+            break;
+        const fingerprint *want = &pinned[k].fp;
+        SL_CHECK_MSG(strcmp(pinned[k].call, calls[k]) == 0, "pinned entry %zu is for %s", k, pinned[k].call);
+        SL_CHECK_MSG(fp.count_a == want->count_a && fp.count_b == want->count_b, "%s: counts %llu %llu, pinned %llu %llu",
+                     calls[k], (unsigned long long)fp.count_a, (unsigned long long)fp.count_b,
+                     (unsigned long long)want->count_a, (unsigned long long)want->count_b);
+        SL_CHECK_MSG(fp.structure == want->structure, "%s: structure hash %016llx, pinned %016llx", calls[k],
+                     (unsigned long long)fp.structure, (unsigned long long)want->structure);
+        for (int c = 0; c < 4; c++) {
+            double tol = 1e-5 * want->sums[c][2] + 1e-12;
+            for (int s = 0; s < 3; s++)
+                SL_CHECK_MSG(fabs(fp.sums[c][s] - want->sums[c][s]) <= tol,
+                             "%s: %s sum %d is %.17g, pinned %.17g (tolerance %.3g)", calls[k], channel[c], s,
+                             fp.sums[c][s], want->sums[c][s], tol);
+        }
+    }
+}
+
 int main(void)
 {
     test_determinism();
+    test_fingerprints();
     test_counts();
     test_furball();
     test_fields();

@@ -182,6 +182,16 @@ static void test_trk(void)
     trk_spec v1 = {.version = 1, .be = 0, .n_scalars = 3, .n_props = 2, .n_lines = 4, .lens = lens,
                    .n_count = 4, .scalar_names = snames, .prop_names = pnames};
     check_trk_good(&v1, "/tmp/some dir/bundle.trk");
+    /* v1 big-endian: byte order from hdr_size (1000) alone, v1 has no vox_to_ras to help. */
+    trk_spec v1be = v1;
+    v1be.be = 1;
+    check_trk_good(&v1be, "bundle.trk");
+    {
+        tbuf be1 = {0};
+        write_trk(&be1, &v1be);
+        check_all_prefixes_fail(sl_load_trk, &be1, "trk v1 BE");
+        tb_free(&be1);
+    }
     trk_spec v2 = v1;
     v2.version = 2;
     check_trk_good(&v2, "bundle.trk");

@@ -15,7 +15,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -88,7 +90,7 @@ static buf gzip_bytes(const uint8_t *data, size_t n)
     return out;
 }
 
-static char written[64][512];
+static char written[128][512];
 static int written_count;
 
 static const char *tmp_path(const char *name)
@@ -107,7 +109,7 @@ static const char *write_file(const char *name, const void *data, size_t n)
     if (!f || fwrite(data, 1, n, f) != n)
         abort();
     fclose(f);
-    if (written_count < 64)
+    if (written_count < 128)
         snprintf(written[written_count++], sizeof written[0], "%s", path);
     return path;
 }
@@ -508,6 +510,9 @@ typedef struct nii_opts {
     float offs[3];
     const char *magic;
     int sizeof_hdr;
+    int use_srow;      /* write srow[][] as the sform's 3x3 part (else diag(pixdim)) */
+    float srow[3][3];  /* srow[r][c]: world row r per index c */
+    float quat[3];     /* quatern_b, c, d */
 } nii_opts;
 
 static buf nii_header(const nii_opts *o)
@@ -542,10 +547,15 @@ static buf nii_header(const nii_opts *o)
     for (int i = 0; i < 3; i++)
         buf_f32(&b, o->offs[i] + 100.0f, o->big); /* qoffset: distinct from srow */
     memcpy(h + 268, b.p, 12);
+    b.n = 0;
+    for (int i = 0; i < 3; i++)
+        buf_f32(&b, o->quat[i], o->big);
+    memcpy(h + 256, b.p, 12);
     for (int r = 0; r < 3; r++) {
         b.n = 0;
         for (int c = 0; c < 4; c++)
-            buf_f32(&b, c == 3 ? o->offs[r] : (float)(r == c) * o->pixdim[r + 1], o->big);
+            buf_f32(&b, c == 3 ? o->offs[r] : o->use_srow ? o->srow[r][c] : (float)(r == c) * o->pixdim[r + 1],
+                    o->big);
         memcpy(h + 280 + 16 * r, b.p, 16);
     }
     memcpy(h + 344, o->magic ? o->magic : "n+1\0", 4);
@@ -650,8 +660,10 @@ static void test_nifti(void)
         {{.datatype = 2, .dim = {4, 1, 1, 1, 2}, .pixdim = {1, 1, 1, 1}, .vox_offset = 352}, 4, SL_ERR_UNSUPPORTED,
          "time series"},
         {{.datatype = 128, .dim = {3, 1, 1, 1}, .pixdim = {1, 1, 1, 1}, .vox_offset = 352}, 4, SL_ERR_UNSUPPORTED, "rgb"},
-        {{.datatype = 2, .dim = {3, 1, 1, 1}, .pixdim = {1, 1, 1, 1}, .vox_offset = 1e9f}, 4, SL_ERR_FORMAT,
+        {{.datatype = 2, .dim = {3, 1, 1, 1}, .pixdim = {1, 1, 1, 1}, .vox_offset = 1e6f}, 4, SL_ERR_FORMAT,
          "vox_offset past end"},
+        {{.datatype = 2, .dim = {3, 1, 1, 1}, .pixdim = {1, 1, 1, 1}, .vox_offset = 1e9f}, 4, SL_ERR_LIMIT,
+         "vox_offset above 64 MiB"},
         {{.datatype = 2, .dim = {3, 1, 1, 1}, .pixdim = {1, 1, 1, 1}, .vox_offset = 100}, 4, SL_ERR_FORMAT,
          "vox_offset in header"},
         {{.datatype = 2, .dim = {3, 1, 1, 1}, .pixdim = {1, INFINITY, 1, 1}, .vox_offset = 352}, 4, SL_ERR_FORMAT,
@@ -686,7 +698,7 @@ static void test_raw_json(void)
     }
     write_file("r.raw", raw.p, raw.n);
     const char *json = "{\"raw\": \"r.raw\", \"dims\": [3, 2, 1], \"type\": \"u16\", \"spacing\": [0.25, 0.5, 4],"
-                       " \"origin\": [-1, -2, -3], \"endian\": \"big\", \"comment\": \"ignored\"}";
+                       " \"origin\": [-1, -2, -3], \"endian\": \"big\"}";
     const char *path = write_file("r.json", json, strlen(json));
     sl_dataset *ds = NULL;
     sl_err err = {0};
@@ -748,6 +760,34 @@ static void test_raw_json(void)
         expect_fail(sl_load_raw_json, (const uint8_t *)bad[i].json, strlen(bad[i].json), tmp_path("bad.json"),
                     bad[i].want, bad[i].what);
     expect_fail(sl_load_raw_json, (const uint8_t *)json, strlen(json), NULL, SL_ERR_UNSUPPORTED, "json, no path");
+    /* Strict keys: a typo must not silently read little-endian; a repeated key is refused too. */
+    static const struct { const char *json, *word; } strict[] = {
+        {"{\"raw\": \"r.raw\", \"dims\": [3, 2, 1], \"type\": \"u16\", \"endianness\": \"big\"}",
+         "unknown key 'endianness'"},
+        {"{\"raw\": \"r.raw\", \"dims\": [3, 2, 1], \"type\": \"u16\", \"Spacing\": [1, 1, 1]}",
+         "unknown key 'Spacing'"},
+        {"{\"raw\": \"r.raw\", \"dims\": [3, 2, 1], \"type\": \"u16\", \"endian\": \"big\", \"endian\": \"little\"}",
+         "key 'endian' appears twice"},
+    };
+    for (size_t i = 0; i < sizeof strict / sizeof strict[0]; i++) {
+        sl_dataset *out = (sl_dataset *)(uintptr_t)1;
+        st = sl_load_raw_json((const uint8_t *)strict[i].json, strlen(strict[i].json), tmp_path("s.json"), &out, &err);
+        SL_CHECK_MSG(st == SL_ERR_FORMAT && out == NULL && strstr(err.message, strict[i].word) &&
+                         strstr(err.message, "s.json"),
+                     "strict sidecar %zu: status %d: %s", i, st, err.message);
+    }
+    /* A .gz raw file that is /dev/zero: refused after at most the input bound, at once. */
+    const char *zgz = tmp_path("zero.raw.gz");
+    unlink(zgz);
+    if (symlink("/dev/zero", zgz) != 0)
+        abort();
+    const char *zjson = "{\"raw\": \"zero.raw.gz\", \"dims\": [2, 2, 2], \"type\": \"u8\"}";
+    sl_dataset *zout = NULL;
+    st = sl_load_raw_json((const uint8_t *)zjson, strlen(zjson), tmp_path("z.json"), &zout, &err);
+    SL_CHECK_MSG(st == SL_ERR_FORMAT && zout == NULL && strstr(err.message, "zero.raw.gz") &&
+                     strstr(err.message, "larger than a gzip stream of the 8 bytes"),
+                 "raw.gz -> /dev/zero: status %d: %s", st, err.message);
+    unlink(zgz);
     expect_prefixes_fail(sl_load_raw_json, (const uint8_t *)json, strlen(json), tmp_path("r.json"), "json prefixes");
     free(raw.p);
 }
@@ -814,6 +854,9 @@ static void test_gunzip(void)
     SL_CHECK(sl_gunzip((const uint8_t *)"hello world, not gzip", 21, 100, &out, &n, &err) == SL_ERR_FORMAT);
 }
 
+static void expect_file_fails_fast(const char *path, sl_status want, const char *word, double max_s,
+                                   const char *what);
+
 static void test_files(void)
 {
     uint8_t *data = NULL;
@@ -852,6 +895,9 @@ static void test_files(void)
         SL_CHECK_NEAR(ds->volume.value_min, 65532, 0);
     }
     sl_dataset_destroy(ds);
+    /* Empty files of the header-probed formats: a clear error, no endless probing. */
+    expect_file_fails_fast(write_file("empty.nii", "", 0), SL_ERR_FORMAT, "348", 1.0, "empty .nii");
+    expect_file_fails_fast(write_file("empty.nrrd", "", 0), SL_ERR_FORMAT, "NRRD", 1.0, "empty .nrrd");
     /* Truncated .nii.gz -> FORMAT naming the file. */
     path = write_file("cut.nii.gz", gz.p, gz.n / 2);
     ds = NULL;
@@ -859,6 +905,406 @@ static void test_files(void)
     SL_CHECK(strstr(err.message, "cut.nii.gz") != NULL);
     free(gz.p);
     free(b.p);
+}
+
+/* ------------------------------------------- hostile files on disk */
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Peak resident memory of this process so far, in MiB. */
+static double peak_rss_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
+/* A symbolic link name -> target in the test folder (removed at the end). */
+static const char *make_link(const char *name, const char *target)
+{
+    const char *path = tmp_path(name);
+    unlink(path);
+    if (symlink(target, path) != 0)
+        abort();
+    if (written_count < 128)
+        snprintf(written[written_count++], sizeof written[0], "%s", path);
+    return path;
+}
+
+/* A sparse file of `size` bytes (all zeros, no disk blocks). */
+static const char *make_sparse(const char *name, off_t size)
+{
+    const char *path = write_file(name, "", 0);
+    if (truncate(path, size) != 0)
+        abort();
+    return path;
+}
+
+/* sl_load_file(path) must fail with status want, within max_s seconds,
+ * naming the file and the given word. */
+static void expect_file_fails_fast(const char *path, sl_status want, const char *word, double max_s, const char *what)
+{
+    sl_dataset *ds = (sl_dataset *)(uintptr_t)1;
+    sl_err err = {0};
+    double t0 = now_s();
+    sl_status st = sl_load_file(path, &ds, &err);
+    double dt = now_s() - t0;
+    SL_CHECK_MSG(st == want && ds == NULL, "%s: status %s, want %s: %s", what, sl_status_name(st),
+                 sl_status_name(want), err.message);
+    SL_CHECK_MSG(dt < max_s, "%s: took %.2f s (bound %.1f s)", what, dt, max_s);
+    SL_CHECK_MSG(strstr(err.message, word) != NULL, "%s: message lacks '%s': %s", what, word, err.message);
+    if (st == SL_OK)
+        sl_dataset_destroy(ds);
+}
+
+/* Audit item: a tiny .nhdr whose data file is /dev/zero or a huge file must
+ * not make the loader read more than the header can use. */
+static void test_nrrd_detached_bounded(void)
+{
+    double rss0 = peak_rss_mib();
+    make_link("zero.raw", "/dev/zero");
+    make_sparse("huge.raw", (off_t)5 << 30); /* 5 GiB, above the 4 GiB general limit */
+    static const struct { const char *name, *hdr, *word; sl_status want; } cases[] = {
+        {"z_raw.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: zero.raw\n",
+         "holds more than the 8 bytes", SL_ERR_FORMAT},
+        {"z_skip.nhdr",
+         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nbyte skip: 16\ndata file: zero.raw\n",
+         "holds more than the 24 bytes", SL_ERR_FORMAT},
+        {"z_lines.nhdr",
+         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nline skip: 2\ndata file: zero.raw\n",
+         "data file", SL_ERR_FORMAT},
+        {"z_gzip.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\ndata file: zero.raw\n",
+         "data file", SL_ERR_FORMAT},
+        {"z_ascii.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\ndata file: zero.raw\n",
+         "data file", SL_ERR_FORMAT},
+        {"z_end.nhdr",
+         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nbyte skip: -1\ndata file: zero.raw\n",
+         "not a regular file", SL_ERR_IO},
+        {"h_raw.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: huge.raw\n",
+         "holds more than the 8 bytes", SL_ERR_FORMAT},
+        {"h_gzip.nhdr", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\ndata file: huge.raw\n",
+         "data file", SL_ERR_FORMAT},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *path = write_file(cases[i].name, cases[i].hdr, strlen(cases[i].hdr));
+        expect_file_fails_fast(path, cases[i].want, cases[i].word, 2.0, cases[i].name);
+    }
+    /* byte skip -1 on the sparse 5 GiB file: its last 8 bytes are the data (seeked to, not read through). */
+    const char *end = "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 1\nencoding: raw\nbyte skip: -1\n"
+                      "data file: huge.raw\n";
+    const char *path = write_file("h_end.nhdr", end, strlen(end));
+    sl_dataset *ds = NULL;
+    sl_err err = {0};
+    double t0 = now_s();
+    sl_status st = sl_load_file(path, &ds, &err);
+    double dt = now_s() - t0;
+    SL_CHECK_MSG(st == SL_OK && ds, "byte skip -1 on a sparse 5 GiB file: %s", err.message);
+    SL_CHECK_MSG(dt < 2.0, "byte skip -1 on a sparse 5 GiB file took %.2f s", dt);
+    if (ds) {
+        double zero[4] = {0, 0, 0, 0};
+        check_values(ds, zero, 0, "tail of sparse file");
+    }
+    sl_dataset_destroy(ds);
+    /* A data file shorter than byte skip -1 needs. */
+    write_file("short.raw", "abc", 3);
+    const char *shorter = "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 1\nencoding: raw\nbyte skip: -1\n"
+                          "data file: short.raw\n";
+    path = write_file("short.nhdr", shorter, strlen(shorter));
+    expect_file_fails_fast(path, SL_ERR_FORMAT, "fewer than the 8 needed", 2.0, "byte skip -1, short file");
+    double grown = peak_rss_mib() - rss0;
+    SL_CHECK_MSG(grown < 64.0, "hostile detached files raised the peak RSS by %.0f MiB", grown);
+    /* An attached .nrrd or a .nii that is /dev/zero: refused from the first bytes. */
+    expect_file_fails_fast(make_link("zero.nrrd", "/dev/zero"), SL_ERR_FORMAT, "NRRD", 2.0, ".nrrd -> /dev/zero");
+    expect_file_fails_fast(make_link("zero.nii", "/dev/zero"), SL_ERR_FORMAT, "sizeof_hdr", 2.0, ".nii -> /dev/zero");
+    expect_file_fails_fast(make_link("zero.nhdr", "/dev/zero"), SL_ERR_FORMAT, "NRRD", 2.0, ".nhdr -> /dev/zero");
+}
+
+/* Detached .nhdr with encoding gzip: good, and a bomb. */
+static void test_nrrd_detached_gzip(void)
+{
+    buf raw = {0};
+    double expect[12];
+    buf_str(&raw, "SKIP");
+    for (int i = 0; i < 12; i++) {
+        expect[i] = -50 + 9 * i;
+        buf_int(&raw, (uint16_t)(int16_t)(-50 + 9 * i), 2, 1);
+    }
+    buf gz = gzip_bytes(raw.p, raw.n);
+    write_file("g.raw.gz", gz.p, gz.n);
+    free(gz.p);
+    free(raw.p);
+    const char *hdr = "NRRD0005\ntype: int16\ndimension: 3\nsizes: 3 2 2\nendian: big\nencoding: gzip\n"
+                      "byte skip: 4\ndata file: g.raw.gz\n";
+    const char *path = write_file("g.nhdr", hdr, strlen(hdr));
+    sl_dataset *ds = NULL;
+    sl_err err = {0};
+    SL_CHECK_MSG(sl_load_file(path, &ds, &err) == SL_OK, "detached gzip: %s", err.message);
+    if (ds) {
+        SL_CHECK(ds->volume.type == SL_VOXEL_S16 && ds->volume.dims[0] == 3 && ds->volume.dims[2] == 2);
+        check_values(ds, expect, 0, "nrrd detached gzip");
+        check_range(ds, expect, 12);
+    }
+    sl_dataset_destroy(ds);
+    /* The same file with no byte skip is 4 bytes too long once inflated. */
+    const char *no_skip = "NRRD0005\ntype: int16\ndimension: 3\nsizes: 3 2 2\nendian: big\nencoding: gzip\n"
+                          "data file: g.raw.gz\n";
+    path = write_file("g2.nhdr", no_skip, strlen(no_skip));
+    expect_file_fails_fast(path, SL_ERR_LIMIT, "limit of 24", 2.0, "detached gzip without byte skip");
+    /* Bomb: 64 MiB of zeros (~64 KiB compressed) behind a 2x2x2 header. */
+    size_t big = 64u << 20;
+    uint8_t *zeros = calloc(big, 1);
+    gz = gzip_bytes(zeros, big);
+    free(zeros);
+    write_file("bomb.raw.gz", gz.p, gz.n);
+    free(gz.p);
+    const char *bomb = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\ndata file: bomb.raw.gz\n";
+    path = write_file("bomb.nhdr", bomb, strlen(bomb));
+    expect_file_fails_fast(path, SL_ERR_LIMIT, "inflates past the limit of 8", 2.0, "detached gzip bomb");
+}
+
+/* A gzip file of `prefix` followed by `mib` MiB of zeros: one member for
+ * the prefix, then one ~1 KB member per MiB of zeros (concatenated gzip is
+ * one file to every reader, and this is fast to build). */
+static buf gzip_with_zeros(const uint8_t *prefix, size_t n, unsigned mib)
+{
+    buf out = {0};
+    if (n) {
+        buf head = gzip_bytes(prefix, n);
+        buf_add(&out, head.p, head.n);
+        free(head.p);
+    }
+    uint8_t *zeros = calloc(1u << 20, 1);
+    buf member = gzip_bytes(zeros, 1u << 20);
+    free(zeros);
+    for (unsigned k = 0; k < mib; k++)
+        buf_add(&out, member.p, member.n);
+    free(member.p);
+    return out;
+}
+
+/* Audit item: a 1 MB .nii.gz that inflates to 1 GiB is read only as far as
+ * its header says; formats without a stated size are capped by ratio. */
+static void test_gzip_bombs(void)
+{
+    nii_opts o = {.datatype = 2, .bitpix = 8, .dim = {3, 2, 2, 2, 1, 1, 1, 1}, .pixdim = {1, 1, 1, 1},
+                  .vox_offset = 352};
+    buf b = nii_header(&o);
+    for (int i = 0; i < 8; i++)
+        buf_int(&b, (uint64_t)(10 + i), 1, 0);
+    buf gz = gzip_with_zeros(b.p, b.n, 1024);
+    SL_CHECK_MSG(gz.n < (2u << 20), "1 GiB bomb compresses to %zu bytes", gz.n);
+    const char *path = write_file("bomb.nii.gz", gz.p, gz.n);
+    double rss0 = peak_rss_mib(), t0 = now_s();
+    sl_dataset *ds = NULL;
+    sl_err err = {0};
+    sl_status st = sl_load_file(path, &ds, &err);
+    double dt = now_s() - t0, grown = peak_rss_mib() - rss0;
+    SL_CHECK_MSG(st == SL_OK && ds, "nii.gz bomb with a valid header: %s", err.message);
+    SL_CHECK_MSG(dt < 1.0, "nii.gz bomb took %.2f s", dt);
+    SL_CHECK_MSG(grown < 16.0, "nii.gz bomb raised the peak RSS by %.0f MiB", grown);
+    if (ds) {
+        double e[8] = {10, 11, 12, 13, 14, 15, 16, 17};
+        check_values(ds, e, 0, "nii.gz bomb voxels");
+    }
+    sl_dataset_destroy(ds);
+    free(gz.p);
+
+    /* The header lies: dims 1024^3 u8 but only 16 MiB of zeros follow: it costs what the file holds. */
+    nii_opts lie = o;
+    lie.dim[1] = lie.dim[2] = lie.dim[3] = 1024;
+    free(b.p);
+    b = nii_header(&lie);
+    gz = gzip_with_zeros(b.p, b.n, 16);
+    path = write_file("liar.nii.gz", gz.p, gz.n);
+    rss0 = peak_rss_mib();
+    expect_file_fails_fast(path, SL_ERR_FORMAT, "truncated", 5.0, "nii.gz with a lying dim");
+    grown = peak_rss_mib() - rss0;
+    SL_CHECK_MSG(grown < 96.0, "nii.gz with a lying dim raised the peak RSS by %.0f MiB (16 MiB content)", grown);
+    free(gz.p);
+    free(b.p);
+
+    /* vox_offset far past the header: refused before inflating. */
+    nii_opts far = o;
+    far.vox_offset = 1e9f;
+    b = nii_header(&far);
+    gz = gzip_bytes(b.p, b.n);
+    path = write_file("far.nii.gz", gz.p, gz.n);
+    expect_file_fails_fast(path, SL_ERR_LIMIT, "vox_offset", 1.0, "nii.gz with vox_offset 1e9");
+    free(gz.p);
+    free(b.p);
+
+    /* A gzip stream of empty stored blocks: no output, endless input; refused at the input bound. */
+    buf empty = {0};
+    static const uint8_t gz_header[10] = {0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3};
+    buf_add(&empty, gz_header, sizeof gz_header);
+    for (int i = 0; i < 40000; i++)
+        buf_add(&empty, "\0\0\0\377\377", 5);
+    path = write_file("empty_blocks.nii.gz", empty.p, empty.n);
+    expect_file_fails_fast(path, SL_ERR_LIMIT, "compressed bytes", 1.0, "endless empty deflate blocks");
+    free(empty.p);
+
+    /* A line format states no size: 1 GiB of zeros in ~1 MB stops at 64 MiB. */
+    gz = gzip_with_zeros(NULL, 0, 1024);
+    path = write_file("bomb.trk.gz", gz.p, gz.n);
+    expect_file_fails_fast(path, SL_ERR_LIMIT, "64 x the compressed size", 5.0, "trk.gz bomb");
+    free(gz.p);
+    /* Attached .nrrd.gz with raw data: read to header + data + 1 byte, no further. */
+    buf n = {0};
+    buf_str(&n, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n");
+    for (int i = 0; i < 8; i++)
+        buf_int(&n, (uint64_t)i, 1, 0);
+    gz = gzip_with_zeros(n.p, n.n, 1024);
+    path = write_file("bomb.nrrd.gz", gz.p, gz.n);
+    rss0 = peak_rss_mib();
+    expect_file_fails_fast(path, SL_ERR_FORMAT, "need exactly 8", 1.0, "nrrd.gz with 1 GiB after the data");
+    grown = peak_rss_mib() - rss0;
+    SL_CHECK_MSG(grown < 16.0, "nrrd.gz bomb raised the peak RSS by %.0f MiB", grown);
+    free(gz.p);
+    gz = gzip_bytes(n.p, n.n);
+    path = write_file("ok.nrrd.gz", gz.p, gz.n);
+    ds = NULL;
+    SL_CHECK_MSG(sl_load_file(path, &ds, &err) == SL_OK, "nrrd.gz: %s", err.message);
+    if (ds) {
+        double e[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+        check_values(ds, e, 0, "nrrd.gz");
+    }
+    sl_dataset_destroy(ds);
+    free(gz.p);
+    free(n.p);
+}
+
+/* ------------------------------------------------------------ orientation */
+
+/* Every stored voxel k (x fastest in dims) sits at world origin + sum_a i_a * axes[a];
+ * the loaded volume must hold its value at that world position, on its grid. */
+static void check_world(const sl_dataset *ds, const int dims[3], const double axes[3][3], const double origin[3],
+                        const double *values, const char *what)
+{
+    const sl_volume *v = &ds->volume;
+    const double o[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
+    int bad = 0;
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX};
+    size_t k = 0;
+    for (int i2 = 0; i2 < dims[2]; i2++)
+        for (int i1 = 0; i1 < dims[1]; i1++)
+            for (int i0 = 0; i0 < dims[0]; i0++, k++) {
+                size_t idx[3];
+                int inside = 1;
+                for (int c = 0; c < 3; c++) {
+                    double w = origin[c] + i0 * axes[0][c] + i1 * axes[1][c] + i2 * axes[2][c];
+                    if (w < lo[c])
+                        lo[c] = w;
+                    double g = (w - o[c]) / v->spacing[c];
+                    long r = lround(g);
+                    inside &= fabs(g - (double)r) < 1e-9 && r >= 0 && r < v->dims[c];
+                    idx[c] = (size_t)(r < 0 ? 0 : r);
+                }
+                if (!inside || sl_volume_value(v, idx[0], idx[1], idx[2], 0) != values[k]) {
+                    if (bad++ < 3)
+                        fprintf(stderr, "%s: stored voxel %zu (value %g) is not at its world position\n", what, k,
+                                values[k]);
+                }
+            }
+    SL_CHECK_MSG(bad == 0, "%s: %d voxels misplaced", what, bad);
+    SL_CHECK_NEAR(ds->bounds_min.x, lo[0], 1e-9);
+    SL_CHECK_NEAR(ds->bounds_min.y, lo[1], 1e-9);
+    SL_CHECK_NEAR(ds->bounds_min.z, lo[2], 1e-9);
+}
+
+static void test_orientation(void)
+{
+    /* NRRD: LPS-style negative x and z, and a permutation with flips. */
+    static const struct { const char *dirs; double axes[3][3]; int dims[3]; } nrrd_cases[] = {
+        {"(-2,0,0) (0,3,0) (0,0,-1)", {{-2, 0, 0}, {0, 3, 0}, {0, 0, -1}}, {3, 2, 2}},
+        {"(0,0.5,0) (2,0,0) (0,0,-3)", {{0, 0.5, 0}, {2, 0, 0}, {0, 0, -3}}, {4, 3, 2}},
+        {"(0,0,-1.5) (0,-1,0) (4,0,0)", {{0, 0, -1.5}, {0, -1, 0}, {4, 0, 0}}, {2, 3, 4}},
+    };
+    const double origin[3] = {10, 20, 30};
+    for (size_t t = 0; t < sizeof nrrd_cases / sizeof nrrd_cases[0]; t++) {
+        const int *d = nrrd_cases[t].dims;
+        buf b = {0};
+        char hdr[512];
+        snprintf(hdr, sizeof hdr,
+                 "NRRD0005\ntype: uchar\ndimension: 3\nsizes: %d %d %d\nspace: left-posterior-superior\n"
+                 "space directions: %s\nspace origin: (10,20,30)\nencoding: raw\n\n",
+                 d[0], d[1], d[2], nrrd_cases[t].dirs);
+        buf_str(&b, hdr);
+        double values[64];
+        int n = d[0] * d[1] * d[2];
+        for (int i = 0; i < n; i++) {
+            values[i] = 3 * i + 1;
+            buf_int(&b, (uint64_t)(3 * i + 1), 1, 0);
+        }
+        sl_dataset *ds = expect_load(sl_load_nrrd, b.p, b.n, "o.nrrd", nrrd_cases[t].dirs);
+        if (ds) {
+            for (int c = 0; c < 3; c++)
+                SL_CHECK(ds->volume.spacing[c] > 0);
+            check_world(ds, d, nrrd_cases[t].axes, origin, values, nrrd_cases[t].dirs);
+        }
+        sl_dataset_destroy(ds);
+        free(b.p);
+    }
+    /* A 4D vector field with a flipped axis: vectors move with their voxels, unchanged. */
+    buf b = {0};
+    buf_str(&b, "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 2 1 1\nspace directions: none (-1,0,0) (0,1,0) "
+                "(0,0,1)\nspace origin: (5,0,0)\nendian: little\nencoding: raw\n\n");
+    for (int i = 0; i < 6; i++)
+        buf_f32(&b, (float)(i + 1), 0);
+    sl_dataset *ds = expect_load(sl_load_nrrd, b.p, b.n, "ov.nrrd", "nrrd flipped vectors");
+    if (ds) {
+        const float *f = ds->volume.data;
+        SL_CHECK(f[0] == 4 && f[1] == 5 && f[2] == 6 && f[3] == 1 && f[4] == 2 && f[5] == 3);
+        SL_CHECK_NEAR(ds->origin.x, 4.0, 0);
+    }
+    sl_dataset_destroy(ds);
+    free(b.p);
+
+    /* NIfTI sform with negative x (RAS from LPS), and a qform with a 180-degree turn about z plus qfac -1. */
+    nii_opts os = {.datatype = 2, .bitpix = 8, .dim = {3, 3, 2, 2, 1, 1, 1, 1}, .pixdim = {1, 2, 3, 1},
+                   .vox_offset = 352, .sform = 1, .offs = {10, 20, 30}, .use_srow = 1,
+                   .srow = {{-2, 0, 0}, {0, 3, 0}, {0, 0, 1}}};
+    nii_opts oq = {.datatype = 2, .bitpix = 8, .dim = {3, 3, 2, 2, 1, 1, 1, 1}, .pixdim = {-1, 2, 3, 1},
+                   .vox_offset = 352, .qform = 1, .offs = {-90, -80, -70}, .quat = {0, 0, 1}};
+    const struct { nii_opts *o; double axes[3][3]; double origin[3]; const char *what; } nii_cases[] = {
+        {&os, {{-2, 0, 0}, {0, 3, 0}, {0, 0, 1}}, {10, 20, 30}, "nifti sform flip x"},
+        /* qoffset is written as offs + 100; R = diag(-1, -1, 1), qfac -1 flips z. */
+        {&oq, {{-2, 0, 0}, {0, -3, 0}, {0, 0, -1}}, {10, 20, 30}, "nifti qform turn + qfac"},
+    };
+    for (size_t t = 0; t < sizeof nii_cases / sizeof nii_cases[0]; t++) {
+        buf nb = nii_header(nii_cases[t].o);
+        double values[12];
+        for (int i = 0; i < 12; i++) {
+            values[i] = 5 * i;
+            buf_int(&nb, (uint64_t)(5 * i), 1, 0);
+        }
+        ds = expect_load(sl_load_nifti, nb.p, nb.n, "o.nii", nii_cases[t].what);
+        if (ds) {
+            const int d[3] = {3, 2, 2};
+            check_world(ds, d, nii_cases[t].axes, nii_cases[t].origin, values, nii_cases[t].what);
+        }
+        sl_dataset_destroy(ds);
+        free(nb.p);
+    }
+    /* Oblique sform: not handled; axis-aligned from pixdim and the offsets (documented). */
+    nii_opts ob = os;
+    ob.srow[0][0] = -1.4142f;
+    ob.srow[0][1] = 1.4142f;
+    buf nb = nii_header(&ob);
+    for (int i = 0; i < 12; i++)
+        buf_int(&nb, (uint64_t)i, 1, 0);
+    ds = expect_load(sl_load_nifti, nb.p, nb.n, "ob.nii", "nifti oblique sform");
+    if (ds) {
+        SL_CHECK_NEAR(ds->volume.spacing[0], 2, 0);
+        SL_CHECK_NEAR(ds->origin.x, 10, 0);
+        SL_CHECK(((uint8_t *)ds->volume.data)[1] == 1);
+    }
+    sl_dataset_destroy(ds);
+    free(nb.p);
 }
 
 int main(void)
@@ -872,8 +1318,12 @@ int main(void)
     test_nrrd_gzip();
     test_nrrd_vector();
     test_nrrd_detached();
+    test_nrrd_detached_bounded();
+    test_nrrd_detached_gzip();
     test_nrrd_hostile();
     test_nifti();
+    test_gzip_bombs();
+    test_orientation();
     test_raw_json();
     test_gunzip();
     test_files();
