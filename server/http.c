@@ -99,6 +99,8 @@ char *sl_http_metrics(sl_server *srv)
         {"sightline_frame_bytes_sent_total", "Bytes of frame messages sent.", m.bytes_sent},
         {"sightline_messages_received_total", "Client text messages received.", m.messages_in},
         {"sightline_errors_sent_total", "error messages sent to clients.", m.errors_sent},
+        {"sightline_dataset_loads_total", "Datasets loaded or generated (cache misses).", m.dataset_loads},
+        {"sightline_dataset_cache_hits_total", "Sessions given an already loaded dataset.", m.dataset_cache_hits},
     };
     for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
         append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,

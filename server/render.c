@@ -12,7 +12,8 @@
  * Interactive frames (camera phase start/move/end younger than
  * still_delay_ms) render at interactive_scale and JPEG quality; once the
  * delay passes a full-size still frame follows. Sessions are picked round
- * robin so one busy session cannot starve another. Never touches a socket.
+ * robin so one busy session cannot starve another. Sessions on the same
+ * dataset share one loaded copy (dataset_cache.c). Never touches a socket.
  */
 #include "sl_server.h"
 
@@ -26,8 +27,6 @@
 #include <libwebsockets.h>
 
 #include "core/sl_technique.h"
-#include "data/sl_generate.h"
-#include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
 #include "sl_scene.h"
@@ -41,6 +40,7 @@ typedef struct render_ctx {
     uint8_t *rgba;
     size_t rgba_cap;
     unsigned rr;          /* round-robin start */
+    sl_dataset_cache datasets;
 } render_ctx;
 
 /* Picks work under the lock; fills *deadline_ms with the next still due time (or leaves it). */
@@ -98,12 +98,18 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return rc;
     if (strcmp(s->loaded_source, st->dataset_source) != 0 || !sl_pipeline_dataset(s->pipeline)) {
         sl_dataset *ds = NULL;
-        rc = st->dataset_is_file ? sl_load_file(st->dataset_source, &ds, err)
-                                 : sl_generate_json(st->dataset_source, &ds, err);
+        uint64_t loads = ctx->datasets.loads;
+        rc = sl_dataset_cache_get(&ctx->datasets, st->dataset_source, st->dataset_is_file, &ds, err);
         if (rc) {
             sl_err_prefix(err, "dataset \"%s\"", st->dataset);
             return rc;
         }
+        pthread_mutex_lock(&ctx->srv->lock);
+        if (ctx->datasets.loads != loads)
+            ctx->srv->metrics.dataset_loads++;
+        else
+            ctx->srv->metrics.dataset_cache_hits++;
+        pthread_mutex_unlock(&ctx->srv->lock);
         char *b = NULL, *c = NULL, *a = NULL;
         sl_catalog_describe(ds, &b, &c, &a);
         sl_pipeline_set_dataset(s->pipeline, ds);
@@ -324,6 +330,7 @@ static void *render_main(void *arg)
     }
     reap(srv);
     pthread_mutex_unlock(&srv->lock);
+    sl_dataset_cache_deinit(&ctx.datasets);
     free(copy);
     free(ctx.rgba);
     sl_encoder_destroy(ctx.enc);

@@ -5,6 +5,7 @@
  *   session.c  sessions, clients, control, grace period, message handling
  *              (service thread)
  *   render.c   the render thread: owns sl_gpu and one sl_pipeline per session
+ *   dataset_cache.c  loaded datasets shared by sessions (render thread)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
@@ -185,6 +186,7 @@ typedef struct sl_histogram {
 typedef struct sl_metrics {                  /* [lock] */
     uint64_t frames_rendered, frames_sent, frames_dropped, frames_failed;
     uint64_t snapshots, bytes_sent, messages_in, errors_sent;
+    uint64_t dataset_loads, dataset_cache_hits;
     sl_histogram render_ms, encode_ms;
 } sl_metrics;
 
@@ -226,6 +228,24 @@ void sl_session_free(sl_session *s);          /* render thread or shutdown; not 
 int sl_client_queue_text(sl_client *c, char *text);
 /* Called from ws.c on writable: sends one message. Returns -1 to close. */
 int sl_client_write_next(sl_server *srv, sl_client *c);
+
+/* dataset_cache.c (render thread only) */
+#define SL_DATASET_CACHE_SLOTS 4
+typedef struct sl_dataset_cache {
+    struct {
+        char source[SL_SOURCE_MAX];
+        sl_dataset *dataset;  /* one owner's reference, NULL when empty */
+        uint64_t used;        /* clock of the last get */
+        uint64_t stamp[4];    /* files: inode, size, mtime s/ns when loaded */
+    } slot[SL_DATASET_CACHE_SLOTS];
+    uint64_t clock, loads, hits;
+} sl_dataset_cache;
+/* The dataset of source (a file path when is_file, else generator JSON):
+ * the cached copy, or loaded and cached. *out is the caller's own reference
+ * (give it to sl_pipeline_set_dataset or sl_dataset_destroy it). On failure
+ * *out is NULL and err says why (a changed file's stale entry is dropped). */
+sl_status sl_dataset_cache_get(sl_dataset_cache *c, const char *source, int is_file, sl_dataset **out, sl_err *err);
+void sl_dataset_cache_deinit(sl_dataset_cache *c); /* drops the cache's references */
 
 /* render.c */
 sl_status sl_render_start(sl_server *srv, sl_err *err);

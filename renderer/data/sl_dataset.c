@@ -18,10 +18,19 @@ sl_dataset *sl_dataset_create(sl_dataset_kind kind, const char *name)
     return ds;
 }
 
+sl_dataset *sl_dataset_retain(sl_dataset *ds)
+{
+    if (ds)
+        atomic_fetch_add(&ds->extra_owners, 1);
+    return ds;
+}
+
 void sl_dataset_destroy(sl_dataset *ds)
 {
     if (!ds)
         return;
+    if (atomic_fetch_sub(&ds->extra_owners, 1) > 0)
+        return; /* another owner keeps it */
     sl_lines *l = &ds->lines;
     free(l->line_offsets);
     free(l->positions);

@@ -11,6 +11,7 @@
 #ifndef SL_DATASET_H
 #define SL_DATASET_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -73,11 +74,17 @@ typedef struct sl_dataset {
     sl_lines lines;          /* kind == SL_DATASET_LINES */
     sl_volume volume;        /* kind == SL_DATASET_VOLUME or SL_DATASET_VECTORS */
     double load_ms;
+    atomic_int extra_owners;  /* owners besides the creator (sl_dataset_retain) */
 } sl_dataset;
 
 /* Allocates an empty dataset of the given kind; NULL on allocation failure. */
 sl_dataset *sl_dataset_create(sl_dataset_kind kind, const char *name);
-void sl_dataset_destroy(sl_dataset *ds); /* NULL is fine */
+/* Drops one owner's reference; the last one frees everything. NULL is fine. */
+void sl_dataset_destroy(sl_dataset *ds);
+/* Adds an owner (a cache and the pipelines that draw the same data); each
+ * owner calls sl_dataset_destroy once. A dataset is read-only once loaded, so
+ * owners on different threads may read it at the same time. Returns ds. */
+sl_dataset *sl_dataset_retain(sl_dataset *ds);
 
 /* Allocates the arrays of an empty line set: offsets and positions, plus
  * radii / tangents when asked. Fails with SL_ERR_LIMIT above the limits. */

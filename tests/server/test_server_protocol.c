@@ -866,6 +866,30 @@ int main(void)
     SL_CHECK(strstr(body, "sightline_encode_ms_bucket{le=\"+Inf\"}") != NULL);
     SL_CHECK(http_get(h.port, "/no-such-file", body, sizeof body) == 404);
 
+    /* --- two new sessions on the same dataset share one loaded copy: two
+     *     datasets handed out, at most one of them loaded --- */
+    {
+        SL_CHECK(http_get(h.port, "/metrics", body, sizeof body) == 200);
+        double loads0 = metric(body, "sightline_dataset_loads_total");
+        double hits0 = metric(body, "sightline_dataset_cache_hits_total");
+        SL_CHECK(loads0 >= 1 && hits0 >= 0);
+        tclient s1, s2;
+        SL_CHECK(tclient_connect(&s1, h.port, NULL) == 0 && tclient_hello(&s1, NULL, NULL, 32, 32) == 0);
+        s1.auto_ack = 1;
+        SL_CHECK(tclient_wait_frame(&s1, 0, 0, T) == 0);
+        SL_CHECK(tclient_connect(&s2, h.port, NULL) == 0 && tclient_hello(&s2, NULL, NULL, 32, 32) == 0);
+        s2.auto_ack = 1;
+        SL_CHECK(tclient_wait_frame(&s2, 0, 0, T) == 0);
+        SL_CHECK(strcmp(s1.session, s2.session) != 0);
+        SL_CHECK(http_get(h.port, "/metrics", body, sizeof body) == 200);
+        double loads1 = metric(body, "sightline_dataset_loads_total");
+        double hits1 = metric(body, "sightline_dataset_cache_hits_total");
+        SL_CHECK_MSG(loads1 + hits1 - loads0 - hits0 == 2 && loads1 - loads0 <= 1,
+                     "loads %g -> %g, cache hits %g -> %g", loads0, loads1, hits0, hits1);
+        tclient_close(&s1);
+        tclient_close(&s2);
+    }
+
     /* --- a late joiner is not told about a render error from before it joined
      *     (the vanished file above failed, then the session rendered again) --- */
     tclient late;
