@@ -289,6 +289,15 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
     cJSON_AddItemToObject(s, "wall_ms", summary(wall_ms, o->frames));
     cJSON_AddNumberToObject(s, "dataset_load_ms", load_ms);
     cJSON_AddNumberToObject(s, "prepare_ms", first->prepare_ms);
+    /* The technique's split of prepare_ms (null where it reports none). */
+    const char *split[] = {"preprocess_ms", "upload_ms", "gpu_preprocess_ms"};
+    double split_ms[] = {first->prepare.preprocess_ms, first->prepare.upload_ms, first->prepare.gpu_ms};
+    for (int i = 0; i < 3; i++) {
+        if (first->prepare_reported)
+            cJSON_AddNumberToObject(s, split[i], split_ms[i]);
+        else
+            cJSON_AddNullToObject(s, split[i]);
+    }
     cJSON_AddNumberToObject(s, "gpu_bytes", (double)last->gpu_bytes);
     cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
     cJSON_AddNumberToObject(s, "culled", last->render.culled);

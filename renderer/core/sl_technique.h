@@ -38,6 +38,15 @@ typedef struct sl_render_stats {
     double culled;           /* primitives skipped by culling */
 } sl_render_stats;
 
+/* Where the time of the last prepare went (fill what applies; zero is fine).
+ * preprocess_ms + upload_ms need not add up to the pipeline's prepare_ms,
+ * which also counts what neither covers. */
+typedef struct sl_prepare_stats {
+    double preprocess_ms;    /* CPU work: building meshes, nodes, voxel grids */
+    double upload_ms;        /* creating and filling buffers and textures, to a glFinish */
+    double gpu_ms;           /* GPU compute passes of the prepare (timer query) */
+} sl_prepare_stats;
+
 typedef struct sl_technique {
     const char *name;
     const char *description;          /* one line, with the paper where there is one */
@@ -51,6 +60,8 @@ typedef struct sl_technique {
                         sl_target *target, sl_render_stats *stats, sl_err *err);
     void (*release)(void *state);     /* NULL state is fine */
     size_t (*gpu_bytes)(const void *state); /* GPU memory held; may be NULL */
+    /* Timings of the prepare that made state; may be NULL (not reported). */
+    void (*prepare_stats)(const void *state, sl_prepare_stats *out);
 } sl_technique;
 
 /* The registry (sl_registry.c holds the one table). */

@@ -99,6 +99,10 @@ sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
         glFinish();
         stats->prepare_ms = sl_now_ms() - t0;
         stats->prepared = 1;
+        if (p->technique->prepare_stats) {
+            p->technique->prepare_stats(p->state, &stats->prepare);
+            stats->prepare_reported = 1;
+        }
         p->prepared_params = p->params;
         p->stale = 0;
     }

@@ -22,6 +22,8 @@ typedef struct sl_frame_stats {
     double wall_ms;       /* wall time of render + finish */
     double prepare_ms;    /* time of the prepare this frame triggered, or 0 */
     int prepared;         /* 1 when this frame re-ran prepare */
+    int prepare_reported; /* 1 when prepare (below) comes from the technique */
+    sl_prepare_stats prepare; /* the technique's split of prepare_ms, when prepared */
     size_t gpu_bytes;     /* GPU memory held by the technique's state */
     sl_render_stats render;
 } sl_frame_stats;

@@ -435,7 +435,7 @@ static const sl_param_def test_schema[] = {
     {"v", SL_PARAM_VEC3, -1, 1, {0.1, 0.2, 0.3}, NULL, "rgb", "a vec3", SL_INVALIDATE_FRAME},
 };
 enum { TEST_COUNT = (int)(sizeof test_schema / sizeof test_schema[0]) };
-static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL};
+static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL, NULL};
 
 static void test_private_schema(void)
 {
