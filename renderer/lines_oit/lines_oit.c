@@ -35,7 +35,8 @@ static const sl_param_def lines_oit_params[] = {
      SL_INVALIDATE_PREPARED},
     {"fragment_memory_mb", SL_PARAM_FLOAT, 0.01, 8192, {512}, NULL, "MB",
      "cap on the fragment list pool; pixels that lose fragments are drawn white", SL_INVALIDATE_FRAME},
-    {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {1.0}, NULL, "", "stop blending a pixel at this opacity",
+    {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {1.0}, NULL, "",
+     "stop blending a pixel at this opacity (1: exact reference; voxel_lines defaults to 0.99)",
      SL_INVALIDATE_FRAME},
 };
 

@@ -4,7 +4,11 @@
  * (Kanzler et al.) papers, and the first thing a user sees. prepare builds
  * the mesh on the CPU (tubes_mesh_build.c) and uploads it once; the radius
  * and every shading parameter are uniforms, so only `sides` and `caps`
- * re-prepare. One indexed draw per frame. Render thread only.
+ * re-prepare. One indexed draw per frame. `opacity` (shared by name with
+ * voxel_lines and lines_oit) is 1 = opaque; below 1 the front halves of the
+ * tubes are blended in draw order without sorting and without depth writes —
+ * order-dependent and only approximate where tubes overlap (lines_oit is the
+ * sorted reference). Render thread only.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +23,9 @@ static const sl_param_def tubes_mesh_params[] = {
     SL_LINE_STYLE_PARAMS,
     {"sides", SL_PARAM_INT, 6, 30, {12}, NULL, "", "vertices per cross-section", SL_INVALIDATE_PREPARED},
     {"caps", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "close tube ends with flat caps", SL_INVALIDATE_PREPARED},
+    {"opacity", SL_PARAM_FLOAT, 0.0, 1.0, {1.0}, NULL, "",
+     "1 = opaque; below 1 the tubes' front halves are blended in draw order (unsorted, no depth writes: "
+     "order-dependent; lines_oit sorts)", SL_INVALIDATE_FRAME},
 };
 
 typedef struct tubes_mesh_state {
@@ -144,14 +151,26 @@ static sl_status tubes_mesh_render(void *opaque, const sl_view *view, const sl_p
     glUniform4fv(glGetUniformLocation(s->program, "u_material"), 1, style.material);
     glUniform1i(glGetUniformLocation(s->program, "u_colormap"), 0);
     glBindTextureUnit(0, s->colormap_tex);
+    float opacity = (float)sl_params_float(params, "opacity");
+    int blend = opacity < 1.0f;
+    glUniform1f(glGetUniformLocation(s->program, "u_opacity"), opacity);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
+    /* Translucent: premultiplied colour over what is there, in draw order;
+     * no depth writes, so farther tubes are not hidden by nearer ones. */
+    glDepthMask(blend ? GL_FALSE : GL_TRUE);
+    if (blend) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    } else {
+        glDisable(GL_BLEND);
+    }
     glDisable(GL_CULL_FACE); /* caps and mantles are seen from inside too */
     glBindVertexArray(s->vao);
     glDrawElements(GL_TRIANGLES, s->index_count, GL_UNSIGNED_INT, NULL);
     glBindVertexArray(0);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
     stats->primitives = (double)s->triangles;
     return SL_OK;
 }

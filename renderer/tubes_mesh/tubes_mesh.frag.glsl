@@ -1,5 +1,8 @@
 // tubes_mesh.frag.glsl — Lambert + Blinn-Phong shading of the tessellated tubes,
-// coloured through a colormap on a scalar (or a constant colour).
+// coloured through a colormap on a scalar (or a constant colour). Output is
+// premultiplied: opacity 1 is opaque; below 1 (blended by tubes_mesh.c, draw
+// order, unsorted) only the front half of each tube is drawn, so a tube
+// crossing a pixel adds one layer, as in lines_oit.
 #include "gpu/glsl/camera.glsl"
 #include "gpu/glsl/lighting.glsl"
 #include "gpu/glsl/colormap.glsl"
@@ -14,6 +17,7 @@ uniform int u_use_colormap;
 uniform vec3 u_color;
 uniform vec3 u_light_eye;        // direction to the light in eye space (x right, y up, z to viewer)
 uniform vec4 u_material;         // ambient, diffuse, specular, shininess
+uniform float u_opacity;         // 1: opaque
 
 layout(location = 0) out vec4 o_color;
 
@@ -23,6 +27,8 @@ void main()
     vec3 l = normalize(u_light_eye.x * sl_right.xyz + u_light_eye.y * sl_up.xyz - u_light_eye.z * sl_forward.xyz);
     vec3 v = normalize(sl_eye.xyz - v_position);
     vec3 n = normalize(v_normal);
+    if (u_opacity < 1.0 && dot(n, v) < 0.0)
+        discard; // back half of a translucent tube
     sl_material m = sl_material(u_material.x, u_material.y, u_material.z, u_material.w);
-    o_color = vec4(sl_shade(base, n, l, v, m), 1.0);
+    o_color = vec4(sl_shade(base, n, l, v, m) * u_opacity, u_opacity);
 }

@@ -5,16 +5,22 @@
  * prepare voxelizes on the CPU (voxelize_cpu.c: exact clipping, face
  * quantization, bit packing, 5-byte headers) or, with `voxelize = gpu`,
  * with compute shaders (voxelize_gpu.c: the same lines, attribute byte
- * included) and uploads headers, lines and the per-voxel density with its
- * mip chain (the density LoD). render casts one ray per pixel in a
- * full-screen fragment pass (voxel_lines.frag.glsl). A camera move only
- * renders; radius, opacity and shading are uniforms; AO is recomputed
- * (compute shader) only when it is on and opacity, radius or its own
- * parameters changed; the grid is rebuilt (by the chosen build) when the
- * colour attribute changes. Grid resolution, quantization and the per-voxel cap
- * re-prepare. Data radii are not used (one radius for all tubes). Lines
- * dropped by the per-voxel cap are reported once per build on stderr.
- * Render thread only. Limits: README.md.
+ * included) and uploads headers and lines. The per-voxel density (eq. 1:
+ * sum of length x the line's weight under the opacity transfer function) and
+ * its mip chain (the density LoD) are computed on the GPU from the uploaded
+ * lines (voxel_lines_density.comp.glsl) at the first frame and whenever the
+ * transfer function, attribute or scalar range change — without
+ * re-voxelizing. render casts one ray per pixel in a full-screen fragment
+ * pass (voxel_lines.frag.glsl). A camera move only renders; radius, opacity
+ * and shading are uniforms; AO is recomputed (compute shader) only when it
+ * is on and opacity, radius, the density or its own parameters changed; the
+ * grid is rebuilt (by the chosen build) when the colour attribute changes or
+ * the radius grows above 1 voxel (2 voxels of padding instead of 1). Grid
+ * resolution, quantization and the per-voxel cap re-prepare. Data radii are
+ * not used (one radius for all tubes). Lines dropped by the per-voxel cap
+ * are reported once per build on stderr (sl_render_stats has no field for
+ * them). Work counters for tests: voxel_lines.h. Render thread only.
+ * Limits: README.md.
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +33,7 @@
 #include "../gpu/sl_gpu.h"
 #include "voxel_gpu.h"
 #include "voxel_grid.h"
+#include "voxel_lines.h"
 #include "voxel_lod.h"
 
 static const char *const quant_choices[] = {"2", "4", "8", "16", "32", "64", "128", "256", NULL};
@@ -52,8 +59,9 @@ static const sl_param_def voxel_lines_params[] = {
      SL_INVALIDATE_PREPARED},
     {"max_lines_per_voxel", SL_PARAM_INT, 1, 255, {255}, NULL, "",
      "cap per voxel (the header count is 8 bits); further lines are dropped and counted", SL_INVALIDATE_PREPARED},
-    {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {0.99}, NULL, "", "early ray termination at this opacity",
-     SL_INVALIDATE_FRAME},
+    {"alpha_threshold", SL_PARAM_FLOAT, 0.5, 1.0, {0.99}, NULL, "",
+     "early ray termination at this opacity (0.99: the ray caster's speed-up; lines_oit, the exact reference, "
+     "defaults to 1)", SL_INVALIDATE_FRAME},
     {"opacity_by_distance", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
      "scale opacity by the distance travelled inside the tube (opacity per diameter)", SL_INVALIDATE_FRAME},
     {"neighbors", SL_PARAM_ENUM, 0, 0, {0}, neighbor_choices, "",
@@ -69,7 +77,7 @@ static const sl_param_def voxel_lines_params[] = {
      SL_INVALIDATE_FRAME},
     {"ao", SL_PARAM_BOOL, 0, 1, {0}, NULL, "", "ambient occlusion from the density field", SL_INVALIDATE_FRAME},
     {"ao_strength", SL_PARAM_FLOAT, 0.0, 1.0, {0.6}, NULL, "", "weight of ambient occlusion", SL_INVALIDATE_FRAME},
-    {"ao_rays", SL_PARAM_INT, 4, 256, {64}, NULL, "", "rays per AO cell", SL_INVALIDATE_FRAME},
+    {"ao_rays", SL_PARAM_INT, 4, 256, {100}, NULL, "", "rays per AO cell (paper: 100)", SL_INVALIDATE_FRAME},
     {"ao_radius", SL_PARAM_FLOAT, 1.0, 16.0, {5.0}, NULL, "voxels", "AO radius of influence", SL_INVALIDATE_FRAME},
 };
 
@@ -77,13 +85,14 @@ typedef struct voxel_lines_state {
     const sl_dataset *dataset;  /* borrowed */
     sl_voxel_frame frame;
     int resolution;             /* the `grid` parameter (0 = automatic) */
+    int padding;                /* empty voxels on each side of the data: 1, or 2 for a radius above 1 voxel */
     int use_gpu;                /* voxelize with compute shaders (voxelize = gpu) */
     int quant, quant_bits, line_bits, max_per_voxel;
     int built_attribute;        /* attribute index of the uploaded attribute bytes, or -1 */
     size_t voxel_count, line_count, grid_bytes;
     double build_ms;
     size_t dropped_overflow, capped_voxels;
-    GLuint program, ao_program, vao, camera_ubo, colormap_tex;
+    GLuint program, ao_program, density_program, vao, camera_ubo, colormap_tex;
     GLuint offsets_buf, counts_buf, lines_buf, density_tex, ao_tex, occupancy_tex, reps_buf;
     int rep_levels, rep_dims[SL_VOXEL_LOD_MAX_LEVELS][3], rep_base[SL_VOXEL_LOD_MAX_LEVELS];
     int occupancy_levels;
@@ -91,8 +100,10 @@ typedef struct voxel_lines_state {
     int ready;                  /* 1 when every grid buffer is uploaded */
     int ao_dims[3];
     int ao_valid;
-    float ao_key[4];            /* extinction, rays, radius, valid */
+    float ao_key[6];            /* extinction, rays, radius and the density key it was computed from */
     int density_levels;
+    int density_valid;          /* level 0 holds the weighted density of density_key */
+    float density_key[3];       /* opacity ramp on, colormap t of bytes 0 and 255 (0, 0 when off) */
 } voxel_lines_state;
 
 static void release_grid(voxel_lines_state *s)
@@ -108,6 +119,7 @@ static void release_grid(voxel_lines_state *s)
     s->reps_buf = 0;
     s->rep_levels = 0;
     s->ao_valid = 0;
+    s->density_valid = 0;
     s->ready = 0;
 }
 
@@ -119,10 +131,19 @@ static void voxel_lines_release(void *opaque)
     release_grid(s);
     if (s->program) glDeleteProgram(s->program);
     if (s->ao_program) glDeleteProgram(s->ao_program);
+    if (s->density_program) glDeleteProgram(s->density_program);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
     free(s);
+}
+
+/* Work counters (voxel_lines.h); render thread only, like every entry point. */
+static sl_voxel_lines_counters counters;
+
+void sl_voxel_lines_get_counters(sl_voxel_lines_counters *out)
+{
+    *out = counters;
 }
 
 static GLuint make_buffer(const void *data, size_t bytes)
@@ -161,7 +182,13 @@ static sl_status upload_occupancy(voxel_lines_state *s, const uint8_t *counts, s
         }
         uint8_t *t = a; a = b; b = t;
     }
-    s->occupancy_levels = 4;
+    /* Up to 4 levels (blocks of 8^3), but no more than the texture can have:
+     * floor(log2(largest side)) + 1 (a grid of 4 + 2 padding has 3). */
+    int maxdim = dm[0] > dm[1] ? dm[0] : dm[1];
+    maxdim = maxdim > dm[2] ? maxdim : dm[2];
+    s->occupancy_levels = 1;
+    while (s->occupancy_levels < 4 && (1 << s->occupancy_levels) <= maxdim)
+        s->occupancy_levels++;
     glCreateTextures(GL_TEXTURE_3D, 1, &s->occupancy_tex);
     glTextureStorage3D(s->occupancy_tex, s->occupancy_levels, GL_R8UI, dm[0], dm[1], dm[2]);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -226,13 +253,14 @@ static sl_status upload_representatives(voxel_lines_state *s, const sl_voxel_gri
 static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *err)
 {
     sl_voxel_grid g;
-    sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = 1,
+    sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = s->padding,
                                .max_per_voxel = s->max_per_voxel, .attribute = attribute};
     sl_status st = s->use_gpu ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
                               : sl_voxel_grid_build(&g, s->dataset, &desc, err);
     if (st != SL_OK)
         return st;
     release_grid(s);
+    counters.builds++;
     s->frame = g.frame;
     s->quant_bits = g.quant_bits;
     s->line_bits = 8 * g.line_bytes;
@@ -262,7 +290,8 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     size_t biggest = line_words * sizeof(uint32_t) > g.voxel_count * sizeof(uint32_t)
                          ? line_words * sizeof(uint32_t) : g.voxel_count * sizeof(uint32_t);
-    if (max_block > 0 && biggest > (size_t)max_block) {
+    /* The shaders address lines by byte offset in 32 bits (voxel_lines_grid.glsl). */
+    if ((max_block > 0 && biggest > (size_t)max_block) || (uint64_t)line_words * 4u > UINT32_MAX) {
         free(packed);
         free(words);
         sl_voxel_grid_deinit(&g);
@@ -284,11 +313,8 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     while ((1 << s->density_levels) <= maxdim)
         s->density_levels++;
     glCreateTextures(GL_TEXTURE_3D, 1, &s->density_tex);
+    /* Filled by update_density (weighted by the opacity transfer function). */
     glTextureStorage3D(s->density_tex, s->density_levels, GL_R32F, g.frame.dims[0], g.frame.dims[1], g.frame.dims[2]);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureSubImage3D(s->density_tex, 0, 0, 0, 0, g.frame.dims[0], g.frame.dims[1], g.frame.dims[2], GL_RED,
-                        GL_FLOAT, g.density);
-    glGenerateTextureMipmap(s->density_tex);
     glTextureParameteri(s->density_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTextureParameteri(s->density_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     const float zero[4] = {0, 0, 0, 0};
@@ -308,6 +334,7 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     glTextureParameteri(s->ao_tex, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
     s->grid_bytes += (size_t)s->ao_dims[0] * s->ao_dims[1] * s->ao_dims[2];
     s->ao_valid = 0;
+    s->density_valid = 0;
     st = upload_occupancy(s, g.counts, err);
     if (st == SL_OK)
         st = upload_representatives(s, &g, err);
@@ -319,6 +346,14 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     s->grid_bytes += s->voxel_count * 8 / 7;
     sl_voxel_grid_deinit(&g);
     return st;
+}
+
+/* Padding (empty voxels around the data) that keeps tubes of radius_g voxels
+ * at the data's edge inside the grid: ceil(radius), at least 1 and at most
+ * 2 (the neighbour search reaches 2 voxels; beyond, tubes are cut anyway). */
+static int padding_for(float radius_g)
+{
+    return radius_g > 1.0f ? 2 : 1;
 }
 
 static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
@@ -338,7 +373,14 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     s->use_gpu = build == 2 || (build == 0 && !sl_gpu_is_software(gpu));
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
-    sl_status st = build_and_upload(s, style.attribute, err);
+    sl_voxel_frame probe;
+    sl_status st = sl_voxel_frame_init(&probe, ds, s->resolution, 1, err); /* h does not depend on padding */
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
+    s->padding = padding_for((float)(style.radius / probe.h));
+    st = build_and_upload(s, style.attribute, err);
     if (st == SL_OK)
         st = sl_gl_program_create(&(sl_program_desc){.vertex = "voxel_lines/voxel_lines_fullscreen.vert.glsl",
                                                      .fragment = "voxel_lines/voxel_lines.frag.glsl",
@@ -348,6 +390,10 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
         st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxel_lines_ao.comp.glsl",
                                                      .label = "voxel_lines_ao"},
                                   &s->ao_program, err);
+    if (st == SL_OK)
+        st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxel_lines_density.comp.glsl",
+                                                     .label = "voxel_lines_density"},
+                                  &s->density_program, err);
     if (st != SL_OK) {
         voxel_lines_release(s);
         return st;
@@ -365,7 +411,24 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
 static void set1f(GLuint p, const char *n, float v) { glUniform1f(glGetUniformLocation(p, n), v); }
 static void set1i(GLuint p, const char *n, int v) { glUniform1i(glGetUniformLocation(p, n), v); }
 
-static void compute_ao(voxel_lines_state *s, float extinction, int rays, float radius)
+/* Dispatches 4^3 groups over dims; the group counts (<= 257 per axis for
+ * SL_VOXEL_MAX_DIM) are checked against the driver's limits anyway. */
+static sl_status dispatch_cells(const int dims[3], const char *what, sl_err *err)
+{
+    GLuint groups[3];
+    for (int c = 0; c < 3; c++) {
+        GLint limit = 0;
+        glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, (GLuint)c, &limit);
+        groups[c] = (GLuint)(dims[c] + 3) / 4;
+        if (limit > 0 && groups[c] > (GLuint)limit)
+            return sl_err_set(err, SL_ERR_LIMIT, "voxel_lines: %s needs %u work groups on axis %d, above the GPU's %d",
+                              what, groups[c], c, limit);
+    }
+    glDispatchCompute(groups[0], groups[1], groups[2]);
+    return SL_OK;
+}
+
+static sl_status compute_ao(voxel_lines_state *s, float extinction, int rays, float radius, sl_err *err)
 {
     glUseProgram(s->ao_program);
     set1i(s->ao_program, "u_density", 0);
@@ -375,9 +438,38 @@ static void compute_ao(voxel_lines_state *s, float extinction, int rays, float r
     set1f(s->ao_program, "u_radius", radius);
     set1f(s->ao_program, "u_extinction", extinction);
     glBindImageTexture(0, s->ao_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R8);
-    glDispatchCompute((GLuint)(s->ao_dims[0] + 3) / 4, (GLuint)(s->ao_dims[1] + 3) / 4,
-                      (GLuint)(s->ao_dims[2] + 3) / 4);
+    sl_status st = dispatch_cells(s->ao_dims, "ambient occlusion", err);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    counters.ao_passes++;
+    return st;
+}
+
+/* Level 0 of the density texture from the uploaded lines, each weighted by
+ * the opacity transfer function (voxel_lines_density.comp.glsl), then the
+ * mip chain (the density octree). key = {ramp on, t of byte 0, t of byte 255}. */
+static sl_status update_density(voxel_lines_state *s, const float key[3], sl_err *err)
+{
+    GLuint p = s->density_program;
+    glUseProgram(p);
+    glUniform3i(glGetUniformLocation(p, "u_dims"), s->frame.dims[0], s->frame.dims[1], s->frame.dims[2]);
+    set1i(p, "u_quant", s->quant);
+    set1i(p, "u_quant_bits", s->quant_bits);
+    set1i(p, "u_line_bits", s->line_bits);
+    set1i(p, "u_opacity_ramp", key[0] != 0.0f);
+    glUniform2f(glGetUniformLocation(p, "u_attr_range"), key[1], key[2]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->offsets_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->counts_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s->lines_buf);
+    glBindImageTexture(0, s->density_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    sl_status st = dispatch_cells(s->frame.dims, "the density pass", err);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    glGenerateTextureMipmap(s->density_tex);
+    counters.density_passes++;
+    if (st == SL_OK) {
+        memcpy(s->density_key, key, sizeof s->density_key);
+        s->density_valid = 1;
+    }
+    return st;
 }
 
 static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
@@ -387,8 +479,29 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     voxel_lines_state *s = opaque;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    if (style.attribute != s->built_attribute || !s->ready) {
+    /* Rebuild (re-voxelize) when the attribute bytes change, or when the
+     * radius grew beyond the padding (the grid's placement keeps h). */
+    int padding = padding_for((float)(style.radius / s->frame.h));
+    if (style.attribute != s->built_attribute || !s->ready || padding > s->padding) {
+        if (padding > s->padding)
+            s->padding = padding;
         sl_status st = build_and_upload(s, style.attribute, err);
+        if (st != SL_OK)
+            return st;
+    }
+    int ramp = style.attribute >= 0 && sl_params_choice(params, "opacity_transfer") == 1;
+    float span = style.scalar_range[1] - style.scalar_range[0];
+    float attr_range[2] = {0.5f, 0.5f};
+    if (style.attribute >= 0 && span > 0.0f) {
+        const sl_attribute *a = &s->dataset->lines.attributes[style.attribute];
+        attr_range[0] = (a->min - style.scalar_range[0]) / span;
+        attr_range[1] = (a->max - style.scalar_range[0]) / span;
+    }
+    /* The density (and so shadows and AO) follows the transfer function;
+     * with a constant opacity the weights are 1 whatever the attribute. */
+    float density_key[3] = {(float)ramp, ramp ? attr_range[0] : 0.0f, ramp ? attr_range[1] : 0.0f};
+    if (!s->density_valid || memcmp(density_key, s->density_key, sizeof density_key) != 0) {
+        sl_status st = update_density(s, density_key, err);
         if (st != SL_OK)
             return st;
     }
@@ -406,9 +519,11 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     if (ao) {
         int rays = sl_params_int(params, "ao_rays");
         float ao_radius = (float)sl_params_float(params, "ao_radius");
-        float key[4] = {extinction, (float)rays, ao_radius, 1.0f};
+        float key[6] = {extinction, (float)rays, ao_radius, density_key[0], density_key[1], density_key[2]};
         if (!s->ao_valid || memcmp(key, s->ao_key, sizeof key) != 0) {
-            compute_ao(s, extinction, rays, ao_radius);
+            sl_status st = compute_ao(s, extinction, rays, ao_radius, err);
+            if (st != SL_OK)
+                return st;
             memcpy(s->ao_key, key, sizeof key);
             s->ao_valid = 1;
         }
@@ -436,18 +551,13 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     set1f(p, "u_inv_h", (float)(1.0 / h));
     set1f(p, "u_radius_g", radius_g);
     set1f(p, "u_opacity", opacity);
-    set1f(p, "u_alpha_stop", opacity >= 1.0f ? 1.0f : (float)sl_params_float(params, "alpha_threshold"));
+    /* Opaque lines end the ray at the first hit (alpha reaches 1); with the
+     * ramp they are translucent even at opacity 1, so the threshold applies. */
+    set1f(p, "u_alpha_stop", opacity >= 1.0f && !ramp ? 1.0f : (float)sl_params_float(params, "alpha_threshold"));
     set1i(p, "u_neighbors", neighbors);
     set1i(p, "u_opacity_by_distance", sl_params_bool(params, "opacity_by_distance"));
     set1i(p, "u_use_colormap", style.attribute >= 0);
-    set1i(p, "u_opacity_ramp", style.attribute >= 0 && sl_params_choice(params, "opacity_transfer") == 1);
-    float span = style.scalar_range[1] - style.scalar_range[0];
-    float attr_range[2] = {0.5f, 0.5f};
-    if (style.attribute >= 0 && span > 0.0f) {
-        const sl_attribute *a = &ds->lines.attributes[style.attribute];
-        attr_range[0] = (a->min - style.scalar_range[0]) / span;
-        attr_range[1] = (a->max - style.scalar_range[0]) / span;
-    }
+    set1i(p, "u_opacity_ramp", ramp);
     glUniform2fv(glGetUniformLocation(p, "u_attr_range"), 1, attr_range);
     glUniform3fv(glGetUniformLocation(p, "u_color"), 1, style.color);
     glUniform3fv(glGetUniformLocation(p, "u_light_eye"), 1, style.light_direction);

@@ -42,8 +42,10 @@ vec3 vx_dequantize(uint face, uint bin)
 // (the line buffer has 8 zero bytes of padding after the last record).
 void vx_line(uint index, out vec3 a, out vec3 b, out uint attr, out uint id)
 {
-    uint pos = index * uint(u_line_bits);
-    uint w = pos >> 5u, o = pos & 31u;
+    // Word and bit from the byte offset (index * bytes < 2^32 for any buffer
+    // below 4 GiB, which voxel_lines.c checks; index * bits would wrap).
+    uint byte_pos = index * uint(u_line_bits >> 3);
+    uint w = byte_pos >> 2u, o = (byte_pos & 3u) * 8u;
     uint w0 = vx_words[w], w1 = vx_words[w + 1u], w2 = vx_words[w + 2u];
     uint lo = (w0 >> o) | ((w1 << 1u) << (31u - o));
     uint hi = (w1 >> o) | ((w2 << 1u) << (31u - o));

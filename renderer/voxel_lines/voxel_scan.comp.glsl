@@ -12,12 +12,13 @@ layout(std430, binding = 1) buffer scan_result { uint scan_out[]; };
 layout(std430, binding = 2) buffer scan_block_sums { uint scan_sums[]; };
 uniform uint u_n;
 uniform uint u_cap;
+uniform uint u_group_base;   // first block of this dispatch chunk (voxelize_gpu.c: dispatch)
 
 shared uint tmp[512];
 
 void main()
 {
-    uint lid = gl_LocalInvocationID.x, block = gl_WorkGroupID.x;
+    uint lid = gl_LocalInvocationID.x, block = u_group_base + gl_WorkGroupID.x;
     uint base = block * 512u;
 #if SCAN_PASS == 1
     for (uint k = 0u; k < 2u; k++) {

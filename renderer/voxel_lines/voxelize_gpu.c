@@ -36,10 +36,25 @@ static GLuint ssbo(size_t bytes, const void *data)
     return b;
 }
 
+/* Dispatches `groups` work groups of `program` along x in chunks of at most
+ * max_groups (the driver's GL_MAX_COMPUTE_WORK_GROUP_COUNT[0], 65535 on
+ * llvmpipe, the GL minimum; a 1-D dispatch above it fails with
+ * GL_INVALID_VALUE and does nothing). Each chunk gets its first group in the
+ * uniform u_group_base, which the shaders add to gl_WorkGroupID.x. */
+static void dispatch(GLuint program, size_t groups, GLuint max_groups)
+{
+    GLint base_loc = glGetUniformLocation(program, "u_group_base");
+    for (size_t first = 0; first < groups; first += max_groups) {
+        size_t n = groups - first < max_groups ? groups - first : max_groups;
+        glUniform1ui(base_loc, (GLuint)first);
+        glDispatchCompute((GLuint)n, 1, 1);
+    }
+}
+
 /* Exclusive scan of n uints of `in` (each capped to cap when cap > 0) into a
  * new buffer (returned; the caller deletes it). Blocks of 512 on the GPU,
  * the block totals scanned recursively. */
-static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap)
+static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap, GLuint max_groups)
 {
     size_t blocks = (n + 511) / 512;
     GLuint out = ssbo(n * sizeof(uint32_t), NULL), sums = ssbo(blocks * sizeof(uint32_t), NULL);
@@ -49,15 +64,15 @@ static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
-    glDispatchCompute((GLuint)blocks, 1, 1);
+    dispatch(prog[0], blocks, max_groups);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     if (blocks > 1) {
-        GLuint scanned = gpu_scan(prog, sums, blocks, 0);
+        GLuint scanned = gpu_scan(prog, sums, blocks, 0, max_groups);
         glUseProgram(prog[1]);
         glUniform1ui(glGetUniformLocation(prog[1], "u_n"), (GLuint)n);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, scanned);
-        glDispatchCompute((GLuint)blocks, 1, 1);
+        dispatch(prog[1], blocks, max_groups);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glDeleteBuffers(1, &scanned);
     }
@@ -65,18 +80,35 @@ static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap)
     return out;
 }
 
-static void run(GLuint program, GLuint count)
+/* One invocation per element 0..count-1, 64 per group. */
+static void run(GLuint program, GLuint count, GLuint max_groups)
 {
     glUseProgram(program);
     glUniform1ui(glGetUniformLocation(program, "u_count"), count);
-    glDispatchCompute((count + 63) / 64, 1, 1);
+    dispatch(program, ((size_t)count + 63) / 64, max_groups);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
 sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const sl_voxel_grid_desc *desc,
                                   sl_err *err)
 {
+    return sl_voxel_grid_build_gpu_chunked(g, ds, desc, 0, err);
+}
+
+sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds, const sl_voxel_grid_desc *desc,
+                                          unsigned max_groups, sl_err *err)
+{
     memset(g, 0, sizeof *g);
+    /* Errors raised before this build are not ours: drain them so the check
+     * at the end reports only this build's. */
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    GLint limit = 0;
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &limit);
+    if (limit <= 0)
+        limit = 65535; /* the GL 4.3 minimum */
+    if (max_groups == 0 || max_groups > (unsigned)limit)
+        max_groups = (unsigned)limit;
     double t0 = sl_now_ms();
     sl_voxel_grid_desc d = desc ? *desc : (sl_voxel_grid_desc){0};
     if (d.quant == 0) d.quant = 32;
@@ -154,7 +186,7 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
 
     /* 1: pieces per curve; their exclusive scan (GPU) gives each curve's
      * first item. The counts are read back only for statistics. */
-    run(prog[0], (GLuint)curves);
+    run(prog[0], (GLuint)curves, max_groups);
     curve_counts = malloc((curves + 1) * sizeof *curve_counts);
     if (!curve_counts) {
         st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization: out of memory");
@@ -170,7 +202,7 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
         st = sl_err_set(err, SL_ERR_LIMIT, "GPU voxelization: more than %u pieces", SL_MAX_VERTICES * 8u);
         goto fail;
     }
-    GLuint curve_starts = gpu_scan(scan_prog, buf[2], curves + 1, 0);
+    GLuint curve_starts = gpu_scan(scan_prog, buf[2], curves + 1, 0, max_groups);
     glDeleteBuffers(1, &buf[2]);
     buf[2] = curve_starts;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buf[0]);
@@ -193,10 +225,10 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     buf[4] = ssbo((g->voxel_count + 1) * sizeof(uint32_t), NULL);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, buf[3]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, buf[4]);
-    run(prog[1], (GLuint)curves);
+    run(prog[1], (GLuint)curves, max_groups);
     glDeleteBuffers(1, &buf[10]); /* the attribute values are read by EMIT only */
     buf[10] = 0;
-    run(prog[2], (GLuint)total);
+    run(prog[2], (GLuint)total, max_groups);
     voxel_counts = malloc(g->voxel_count * sizeof *voxel_counts);
     line_starts = malloc((g->voxel_count + 1) * sizeof *line_starts);
     g->offsets = malloc(g->voxel_count * sizeof *g->offsets);
@@ -210,8 +242,8 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
      * capped (line offsets), on the GPU. The counts are read back for the
      * CPU copy of the headers and the statistics. */
     glGetNamedBufferSubData(buf[4], 0, (GLsizeiptr)(g->voxel_count * sizeof(uint32_t)), voxel_counts);
-    buf[5] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, 0);
-    buf[7] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, (GLuint)d.max_per_voxel);
+    buf[5] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, 0, max_groups);
+    buf[7] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, (GLuint)d.max_per_voxel, max_groups);
     glGetNamedBufferSubData(buf[7], 0, (GLsizeiptr)((g->voxel_count + 1) * sizeof(uint32_t)), line_starts);
     size_t s_kept = line_starts[g->voxel_count];
     for (size_t v = 0; v < g->voxel_count; v++) {
@@ -237,8 +269,8 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     buf[9] = ssbo(g->voxel_count * sizeof(float), NULL);
     for (int b = 5; b < 10; b++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)b, buf[b]);
-    run(prog[3], (GLuint)total);
-    run(prog[4], (GLuint)g->voxel_count);
+    run(prog[3], (GLuint)total, max_groups);
+    run(prog[4], (GLuint)g->voxel_count, max_groups);
     g->lines = calloc(word_count, sizeof(uint32_t));
     if (!g->lines) {
         st = sl_err_set(err, SL_ERR_NOMEM, "GPU voxelization: %zu lines do not fit in memory", s_kept);
@@ -246,6 +278,18 @@ sl_status sl_voxel_grid_build_gpu(sl_voxel_grid *g, const sl_dataset *ds, const 
     }
     glGetNamedBufferSubData(buf[8], 0, (GLsizeiptr)(word_count * sizeof(uint32_t)), g->lines);
     glGetNamedBufferSubData(buf[9], 0, (GLsizeiptr)(g->voxel_count * sizeof(float)), g->density);
+    /* Any failed GL call (a dispatch or buffer above a limit, out of memory)
+     * means some pass did not run: the result would be garbage. */
+    GLenum gl_error = glGetError();
+    if (gl_error != GL_NO_ERROR) {
+        st = sl_err_set(err, SL_ERR_GPU,
+                        "GPU voxelization of %zu voxels and %zu pieces failed with GL error 0x%04x "
+                        "(work-group limit %u per dispatch); use voxelize = cpu or a smaller grid",
+                        g->voxel_count, total, (unsigned)gl_error, max_groups);
+        while (glGetError() != GL_NO_ERROR) {
+        }
+        goto fail;
+    }
     /* The CPU layout keeps 8 zero bytes after the last line. */
     memset(g->lines + s_kept * (size_t)g->line_bytes, 0, word_count * 4 - s_kept * (size_t)g->line_bytes);
     g->build_ms = sl_now_ms() - t0;

@@ -34,6 +34,7 @@ uniform ivec3 u_dims;
 uniform int u_quant;
 uniform int u_k;
 uniform uint u_count;        // curves, items or voxels, by pass
+uniform uint u_group_base;   // first work group of this dispatch chunk (voxelize_gpu.c: dispatch)
 uniform uint u_cap;
 uniform int u_line_bits;
 uniform bool u_has_attr;     // vx_attr holds the chosen attribute; else every value is 0
@@ -270,7 +271,7 @@ float line_length(uint lo, uint hi)
 
 void main()
 {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = (u_group_base + gl_WorkGroupID.x) * 64u + gl_LocalInvocationID.x;
     if (i >= u_count)
         return;
 #if VX_PASS == 1
@@ -301,8 +302,11 @@ void main()
     float len = 0.0;
     for (uint a = 0u; a < keep; a++) {
         uvec4 it = items[slots[start + a]];
-        uint bit = (out_line + a) * uint(u_line_bits);
-        uint w = bit >> 5u, o = bit & 31u;
+        // Word and bit from the byte offset: (line * bytes) stays below 2^32
+        // for any line buffer the GPU can hold (< 4 GiB), while line * bits
+        // would wrap beyond 2^32 bits (~107 M lines of 5 bytes).
+        uint byte_pos = (out_line + a) * uint(u_line_bits / 8);
+        uint w = byte_pos >> 2u, o = (byte_pos & 3u) * 8u;
         atomicOr(words[w], it.y << o);
         if (o > 0u)
             atomicOr(words[w + 1u], it.y >> (32u - o));

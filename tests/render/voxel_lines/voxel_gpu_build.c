@@ -10,7 +10,13 @@
  * the attribute bytes must be equal too (and are checked to vary, so the
  * comparison is not vacuous). Last, tornado's speed is made hostile (NaN,
  * ±inf, values far outside the stored range) and a constant attribute is
- * added; both builds must still agree. Render thread = main.
+ * added; both builds must still agree. Dispatch chunking: the same
+ * comparisons with at most 7 (or 1) work groups per dispatch (every pass and
+ * scan then runs in many chunks, with a partial last one), and one grid above
+ * the real 1-D limit: tornado at grid 184 has 4.3 M voxels, more than
+ * llvmpipe's 65535 groups x 64 invocations of one dispatch of the per-voxel
+ * pass (before chunking that build silently lacked its last pass). Render
+ * thread = main.
  */
 #include <math.h>
 #include <stdio.h>
@@ -23,7 +29,8 @@
 
 /* min_distinct: the least number of distinct attribute bytes the build must
  * hold (0 = no check; 1 with the attribute off, where every byte is 0). */
-static void compare(const sl_dataset *ds, int resolution, int quant, int cap, int attribute, int min_distinct)
+static void compare_chunked(const sl_dataset *ds, int resolution, int quant, int cap, int attribute,
+                            int min_distinct, unsigned max_groups)
 {
     sl_err err = {0};
     sl_voxel_grid_desc desc = {.resolution = resolution, .quant = quant, .padding = 1, .max_per_voxel = cap,
@@ -31,7 +38,7 @@ static void compare(const sl_dataset *ds, int resolution, int quant, int cap, in
     sl_voxel_grid a, b;
     sl_status sa = sl_voxel_grid_build(&a, ds, &desc, &err);
     SL_CHECK_MSG(sa == SL_OK, "cpu: %s", err.message);
-    sl_status sb = sl_voxel_grid_build_gpu(&b, ds, &desc, &err);
+    sl_status sb = sl_voxel_grid_build_gpu_chunked(&b, ds, &desc, max_groups, &err);
     SL_CHECK_MSG(sb == SL_OK, "gpu: %s", err.message);
     if (sa != SL_OK || sb != SL_OK) {
         sl_voxel_grid_deinit(&a);
@@ -71,10 +78,15 @@ static void compare(const sl_dataset *ds, int resolution, int quant, int cap, in
             dmax = fmax(dmax, fabs((double)a.density[v] - b.density[v]));
         SL_CHECK_NEAR(dmax, 0.0, 1e-4);
     }
-    printf("grid %d N %d cap %d attribute %d: %zu lines, cpu %.1f ms, gpu %.1f ms\n", resolution, quant, cap,
-           attribute, a.line_count, a.build_ms, b.build_ms);
+    printf("grid %d N %d cap %d attribute %d groups/dispatch %u: %zu voxels, %zu lines, cpu %.1f ms, gpu %.1f ms\n",
+           resolution, quant, cap, attribute, max_groups, a.voxel_count, a.line_count, a.build_ms, b.build_ms);
     sl_voxel_grid_deinit(&a);
     sl_voxel_grid_deinit(&b);
+}
+
+static void compare(const sl_dataset *ds, int resolution, int quant, int cap, int attribute, int min_distinct)
+{
+    compare_chunked(ds, resolution, quant, cap, attribute, min_distinct, 0);
 }
 
 int main(void)
@@ -101,6 +113,20 @@ int main(void)
         compare(tornado, 64, 32, 255, speed, 100);
         compare(tornado, 48, 256, 255, speed, 100);
         compare(tornado, 16, 16, 20, speed, 50);
+        /* Chunked dispatches (a test-only small limit) give the same grid. */
+        compare_chunked(tornado, 64, 32, 255, speed, 100, 7);
+        compare_chunked(tornado, 16, 16, 20, speed, 50, 1);
+        /* Above the real limit: tornado at grid 184 has 4.3 M voxels (186 x
+         * 153 x 151 with padding), more than 65535 groups of 64 for the
+         * per-voxel pass on a driver at the GL minimum (llvmpipe). */
+        GLint limit = 0;
+        glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &limit);
+        sl_voxel_frame big;
+        SL_CHECK(sl_voxel_frame_init(&big, tornado, 184, 1, &err) == SL_OK);
+        size_t big_groups = ((size_t)big.dims[0] * big.dims[1] * big.dims[2] + 63) / 64;
+        SL_CHECK_MSG(limit > 65535 || big_groups > (size_t)limit, "grid 184: %zu groups, limit %d", big_groups,
+                     limit);
+        compare(tornado, 184, 4, 255, -1, 1);
     }
     if (bundle) {
         compare(bundle, 64, 128, 255, -1, 1);
