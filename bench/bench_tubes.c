@@ -17,8 +17,8 @@
  *    glFinish), tube filter ms, and our ratio to it. When VTK or xvfb-run is
  *    missing the table says "VTK: not available (reason)". SOURCE is
  *    $SIGHTLINE_SOURCE_DIR, else the source tree this was built from.
- * 2. Error against time: root method x iterations (4..32), depth error
- *    against the CPU reference (tests/render/tubes/tubes_reference.c) and ms.
+ * 2. Error against time: every root method x iterations 2..12, 16, 20, 24, 32,
+ *    depth error against the CPU reference (tests/render/tubes/tubes_reference.c) and ms.
  * 3. How far the quadratic pair lies from the true cubic Hermite sweep
  *    (both by the reference) on smaller versions of the five datasets.
  * Defaults (160x90, 3 frames) take a few minutes on llvmpipe; --size
@@ -495,9 +495,9 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
 }
 
 /* Depth error of a GPU distance map against the reference, x the local radius. */
-typedef struct error_stats { double max_all, max_inner, mean; long mismatch, both; } error_stats;
+typedef struct error_stats { double max_all, max_inner, mean; long mismatch, both, away; } error_stats;
 
-static error_stats compare(const float *gpu, const float *ref, const float *rad, const int *seg, int w, int h)
+static error_stats compare(const float *gpu, const float *ref, const float *rad, int w, int h)
 {
     error_stats e = {0};
     for (int j = 0; j < h; j++)
@@ -511,18 +511,11 @@ static error_stats compare(const float *gpu, const float *ref, const float *rad,
             if (!a)
                 continue;
             double rel = fabs((double)gpu[k] - ref[k]) / fmax(rad[k], 1e-30);
-            int sil = 0;
-            for (int dj = -1; dj <= 1; dj++)
-                for (int di = -1; di <= 1; di++) {
-                    int x = i + di, y = j + dj;
-                    if (x < 0 || y < 0 || x >= w || y >= h)
-                        continue;
-                    size_t n = (size_t)y * (size_t)w + (size_t)x;
-                    sil |= (ref[n] > 0.0f) != b || seg[n] != seg[k] || fabsf(ref[n] - ref[k]) > rad[k];
-                }
             e.max_all = fmax(e.max_all, rel);
-            if (!sil)
+            if (!tubes_ref_silhouette(ref, rad, w, h, i, j)) {
                 e.max_inner = fmax(e.max_inner, rel);
+                e.away++;
+            }
             e.mean += rel;
             e.both++;
         }
@@ -541,6 +534,7 @@ static sl_status reference_of(const sl_dataset *ds, const sl_view *view, const s
         return st;
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
+    sl_tubes_nodes_set_radii(&ds->lines, style.radius_attribute, &nodes);
     tubes_ref_desc rd = {.view = view, .origin = ds->origin, .nodes = &nodes, .radius = style.radius,
                          .radius_scale = style.radius_scale, .cubic = cubic};
     tubes_ref_render(&rd, ref, rad, seg);
@@ -580,17 +574,29 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
     ds = NULL;
     printf("\n## Depth error against the reference, by root method and iterations\n\n");
     printf("bundle, %zu segments, radius 1/60 of the bounding radius, %dx%d, close view; error in units of the local "
-           "tube radius; \"away\" excludes reference silhouettes (3x3 coverage/segment/depth-jump change).\n\n", segs, w, h);
-    printf("| method | iterations | max error (away) | max error (all) | mean error | coverage mismatch | frame ms |\n");
-    printf("|---|---:|---:|---:|---:|---:|---:|\n");
-    static const int iters[] = {4, 6, 8, 10, 12, 16, 20, 24, 32};
+           "tube radius; \"away\" excludes reference silhouettes (3x3 coverage change or depth jump > radius; "
+           "tests/render/tubes/tubes_reference.c tubes_ref_silhouette).\n\n", segs, w, h);
+    printf("| method | iterations | max error (away) | max error (all) | mean error | pixels (away / both hit) | "
+           "coverage mismatch | frame ms |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    /* Every count up to 12: a coarse grid would hide the real fewest count. */
+    static const int iters[] = {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 16, 20, 24, 32};
     const int ni = (int)(sizeof iters / sizeof iters[0]);
-    int need[2] = {-1, -1};
-    for (int m = 0; m < 2; m++)
+    const char *const *methods = NULL;
+    int nm = 0;
+    int pm = sl_params_find(&params, "root_method");
+    if (pm >= 0) {
+        methods = params.schema[pm].choices;
+        while (methods[nm])
+            nm++;
+    }
+    int need[8];
+    for (int m = 0; m < nm && m < 8; m++) {
+        need[m] = -1;
         for (int k = 0; k < ni; k++) {
-            double it = iters[k], method = m;
+            double it = iters[k];
             sl_params_set_numbers(&params, "iterations", &it, 1, err);
-            sl_params_set_numbers(&params, "root_method", &method, 1, err);
+            sl_params_set_choice(&params, "root_method", methods[m], err);
             if ((st = sl_pipeline_set_technique(p, tubes, &params, err)) != SL_OK)
                 goto done;
             double ms[3];
@@ -601,18 +607,21 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
                 ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
             }
             sl_pipeline_read_distance(p, &view, gpu_d);
-            error_stats e = compare(gpu_d, ref, rad, seg, w, h);
+            error_stats e = compare(gpu_d, ref, rad, w, h);
             if (need[m] < 0 && e.max_inner <= 1e-3 && e.mean <= 1e-4)
                 need[m] = iters[k];
-            printf("| %s | %d | %.3g | %.3g | %.3g | %ld | %.1f |\n", m ? "illinois" : "bisection", iters[k],
-                   e.max_inner, e.max_all, e.mean, e.mismatch, median(ms, 3));
+            printf("| %s | %d | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f |\n", methods[m], iters[k], e.max_inner,
+                   e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3));
             fflush(stdout);
         }
-    printf("\nFewest iterations (of those tried) for max error away from silhouettes <= 1e-3 and mean error <= 1e-4 "
-           "(x radius): bisection %d, illinois %d", need[0], need[1]);
-    if (need[0] > 0 && need[1] > 0)
-        printf(" (ratio %.2f)", (double)need[0] / need[1]);
-    printf(".\n");
+    }
+    printf("\nFewest iterations for max error away from silhouettes <= 1e-3 and mean error <= 1e-4 (x radius):");
+    for (int m = 0; m < nm && m < 8; m++) {
+        printf(" %s %d", methods[m], need[m]);
+        if (m > 0 && need[0] > 0 && need[m] > 0)
+            printf(" (%.2fx fewer than %s)", (double)need[0] / need[m], methods[0]);
+        printf(m + 1 < nm ? "," : ".\n");
+    }
 done:
     sl_pipeline_destroy(p);
     sl_dataset_destroy(ds);
@@ -667,14 +676,21 @@ static void curve_deviation(const sl_dataset *ds, const sl_params *params, doubl
 
 static sl_status bench_cubic(const options *o, sl_err *err)
 {
-    const int w = 96, h = 96;
+    /* Tubes several pixels wide (radius 1/60 of the bounding radius where the
+     * data gives none, close view as in the error table), so that most pixels
+     * hit are away from a silhouette; at the default radius in a far view
+     * tubes are below a pixel and "away" would be an empty set. */
+    const int w = 128, h = 128;
     printf("\n## Quadratic pair against the true cubic Hermite sweep (reference, both)\n\n");
-    printf("Smaller versions of the generated datasets, %dx%d, far view, default radius. Curve deviation: max and mean "
-           "over segments of |quadratic pair(t) - cubic(t)| at equal parameter (an upper bound of the distance "
-           "between the curves); depth difference on pixels both hit away from silhouettes, and over all pixels both "
-           "hit (there a rim may switch to another tube). All in units of the tube radius.\n\n", w, h);
+    printf("Smaller versions of the generated datasets, %dx%d, close view (distance 1.2), radius 1/60 of the bounding "
+           "radius (hotroom: its data radii). Curve deviation: max and mean over segments of |quadratic pair(t) - "
+           "cubic(t)| at equal parameter (an upper bound of the distance between the curves); depth difference on "
+           "pixels both hit away from silhouettes (3x3 coverage change or depth jump > radius of the cubic "
+           "reference), and over all pixels both hit (there a rim may switch to another tube); pixel counts of both "
+           "sets. All in units of the tube radius.\n\n", w, h);
     printf("| dataset | segments | curve dev. max | curve dev. mean | depth max (away) | depth mean (away) | "
-           "depth max (all) | coverage mismatch |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+           "pixels away | depth max (all) | pixels both hit | coverage mismatch |\n"
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     const sl_technique *tubes = sl_technique_find("tubes");
     for (int d = 0; d < DATASET_COUNT; d++) {
         if (o->only && !strstr(o->only, datasets[d].name))
@@ -685,6 +701,8 @@ static sl_status bench_cubic(const options *o, sl_err *err)
             return st;
         sl_params params;
         sl_params_init(&params, tubes->params, tubes->param_count);
+        double radius = sl_dataset_radius(ds) / 60.0;
+        sl_params_set_numbers(&params, "radius", &radius, 1, err);
         size_t np = (size_t)w * h;
         float *q = calloc(np, sizeof *q), *qr = calloc(np, sizeof *qr), *c = calloc(np, sizeof *c),
               *cr = calloc(np, sizeof *cr);
@@ -692,11 +710,11 @@ static sl_status bench_cubic(const options *o, sl_err *err)
         sl_view view;
         if (!q || !qr || !c || !cr || !seg)
             st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");
-        if (st == SL_OK && (st = make_view(ds, 30.0, 1.0 / sin(22.5 * SL_PI / 180.0), w, h, &view, err)) == SL_OK &&
+        if (st == SL_OK && (st = make_view(ds, 30.0, 1.2, w, h, &view, err)) == SL_OK &&
             (st = reference_of(ds, &view, &params, 0, q, qr, seg, err)) == SL_OK &&
             (st = reference_of(ds, &view, &params, 1, c, cr, seg, err)) == SL_OK) {
             double mx = 0.0, mean = 0.0, mx_all = 0.0;
-            long both = 0, mism = 0;
+            long both = 0, away = 0, mism = 0;
             for (int j = 0; j < h; j++)
                 for (int i = 0; i < w; i++) {
                     size_t k = (size_t)j * w + i;
@@ -706,25 +724,17 @@ static sl_status bench_cubic(const options *o, sl_err *err)
                         continue;
                     double e = fabs((double)q[k] - c[k]) / fmax(cr[k], 1e-30);
                     mx_all = fmax(mx_all, e);
-                    int sil = 0;
-                    for (int dj = -1; dj <= 1; dj++)
-                        for (int di = -1; di <= 1; di++) {
-                            int x = i + di, y = j + dj;
-                            if (x < 0 || y < 0 || x >= w || y >= h)
-                                continue;
-                            size_t n = (size_t)y * w + x;
-                            sil |= (c[n] > 0.0f) != b || fabsf(c[n] - c[k]) > cr[k];
-                        }
-                    if (sil)
+                    both++;
+                    if (tubes_ref_silhouette(c, cr, w, h, i, j))
                         continue;
                     mx = fmax(mx, e);
                     mean += e;
-                    both++;
+                    away++;
                 }
             double dev_max, dev_mean;
             curve_deviation(ds, &params, &dev_max, &dev_mean);
-            printf("| %s | %zu | %.3g | %.3g | %.3g | %.3g | %.3g | %ld |\n", datasets[d].name, segment_count(ds), dev_max,
-                   dev_mean, mx, both ? mean / both : 0.0, mx_all, mism);
+            printf("| %s | %zu | %.3g | %.3g | %.3g | %.3g | %ld | %.3g | %ld | %ld |\n", datasets[d].name,
+                   segment_count(ds), dev_max, dev_mean, mx, away ? mean / away : 0.0, away, mx_all, both, mism);
             fflush(stdout);
         }
         free(q); free(qr); free(c); free(cr); free(seg);

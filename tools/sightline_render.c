@@ -301,6 +301,7 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
     cJSON_AddNumberToObject(s, "gpu_bytes", (double)last->gpu_bytes);
     cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
     cJSON_AddNumberToObject(s, "culled", last->render.culled);
+    cJSON_AddNumberToObject(s, "dropped", last->render.dropped);
     char *out = cJSON_Print(s);
     cJSON_Delete(s);
     errno = 0;

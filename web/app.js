@@ -87,7 +87,7 @@ function datasetByName(name) {
 // attribute names the catalog knows (null until a built-in was first made).
 function paramLabels() {
   const names = datasetByName(app.state?.dataset)?.attributes;
-  return Array.isArray(names) && names.length ? { attribute: names } : {};
+  return Array.isArray(names) && names.length ? { attribute: names, radius_attribute: names } : {};
 }
 
 function buildParams() {

@@ -36,6 +36,8 @@ typedef struct sl_target sl_target;
 typedef struct sl_render_stats {
     double primitives;       /* triangles, boxes or rays issued */
     double culled;           /* primitives skipped by culling */
+    double dropped;          /* pieces of data the technique could not draw
+                                (voxel_lines: lines beyond the per-voxel cap) */
 } sl_render_stats;
 
 /* Where the time of the last prepare went (fill what applies; zero is fine).

@@ -1,9 +1,26 @@
-/* line_style.c — resolves the shared line parameters for one frame (see sl_line_style.h). */
+/* line_style.c — checks and resolves the shared line parameters for one frame (see sl_line_style.h).
+ * Any thread; no GL. */
 #include "sl_line_style.h"
 
 #include <math.h>
 
 #include "../data/sl_dataset.h"
+
+sl_status sl_line_style_check(const sl_params *p, const sl_dataset *ds, sl_err *err)
+{
+    int count = ds->kind == SL_DATASET_LINES ? ds->lines.attribute_count : 0;
+    int a = sl_params_int(p, "attribute");
+    if (a >= count && !(a == 0 && count == 0))
+        return sl_err_set(err, SL_ERR_INVALID, "params.attribute = %d: the dataset has %d per-vertex attribute%s "
+                          "(valid: -1 .. %d)", a, count, count == 1 ? "" : "s", count - 1);
+    if (sl_params_find(p, "radius_attribute") >= 0) {
+        int r = sl_params_int(p, "radius_attribute");
+        if (r >= count)
+            return sl_err_set(err, SL_ERR_INVALID, "params.radius_attribute = %d: the dataset has %d per-vertex "
+                              "attribute%s (valid: -1 .. %d)", r, count, count == 1 ? "" : "s", count - 1);
+    }
+    return SL_OK;
+}
 
 void sl_line_style_read(const sl_params *p, const sl_dataset *ds, sl_line_style *s)
 {
@@ -14,6 +31,9 @@ void sl_line_style_read(const sl_params *p, const sl_dataset *ds, sl_line_style 
     s->attribute = sl_params_int(p, "attribute");
     if (ds->kind != SL_DATASET_LINES || s->attribute >= ds->lines.attribute_count)
         s->attribute = -1;
+    s->radius_attribute = sl_params_find(p, "radius_attribute") >= 0 ? sl_params_int(p, "radius_attribute") : -1;
+    if (ds->kind != SL_DATASET_LINES || s->radius_attribute >= ds->lines.attribute_count)
+        s->radius_attribute = -1;
     s->colormap = sl_params_choice(p, "colormap");
     s->scalar_range[0] = (float)sl_params_float(p, "scalar_min");
     s->scalar_range[1] = (float)sl_params_float(p, "scalar_max");

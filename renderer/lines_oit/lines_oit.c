@@ -50,6 +50,7 @@ typedef struct lines_oit_state {
     GLsizei index_count;
     size_t mesh_bytes, triangles;
     size_t last_fragments;      /* fragments of the last frame (stored or not) */
+    sl_prepare_stats prep;      /* mesh build (CPU) and upload times */
 } lines_oit_state;
 
 static void lines_oit_release(void *opaque)
@@ -83,12 +84,19 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     s->dataset = ds;
     s->colormap_loaded = -1;
     s->attribute_loaded = -2;
-    sl_tube_mesh mesh;
-    sl_status st = sl_tube_mesh_build(&ds->lines, sl_params_int(params, "sides"), 0, &mesh, err);
+    sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK) {
         free(s);
         return st;
     }
+    sl_tube_mesh mesh;
+    double t_build = sl_now_ms();
+    st = sl_tube_mesh_build(&ds->lines, sl_params_int(params, "sides"), 0, &mesh, err);
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
+    s->prep.preprocess_ms = sl_now_ms() - t_build;
     st = sl_gl_program_create(&(sl_program_desc){.vertex = "lines_oit/lines_oit.vert.glsl",
                                                  .fragment = "lines_oit/lines_oit_collect.frag.glsl",
                                                  .label = "lines_oit_collect"},
@@ -103,6 +111,7 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         lines_oit_release(s);
         return st;
     }
+    double t_upload = sl_now_ms();
     glCreateBuffers(1, &s->vbo);
     glNamedBufferStorage(s->vbo, (GLsizeiptr)((mesh.vertex_count ? mesh.vertex_count : 1) * sizeof(sl_tube_vertex)),
                          mesh.vertex_count ? mesh.vertices : NULL, 0);
@@ -140,6 +149,8 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     s->mesh_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t) +
                     (ds->lines.vertex_count + 1) * sizeof(float);
     sl_tube_mesh_deinit(&mesh);
+    glFinish();
+    s->prep.upload_ms = sl_now_ms() - t_upload;
     *out = s;
     return SL_OK;
 }
@@ -224,8 +235,10 @@ static sl_status lines_oit_render(void *opaque, const sl_view *view, const sl_pa
                                   sl_render_stats *stats, sl_err *err)
 {
     (void)target;
-    (void)err;
     lines_oit_state *s = opaque;
+    sl_status st = sl_line_style_check(params, s->dataset, err);
+    if (st != SL_OK)
+        return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
     if (style.colormap != s->colormap_loaded) {
@@ -260,6 +273,12 @@ static sl_status lines_oit_render(void *opaque, const sl_view *view, const sl_pa
     return SL_OK;
 }
 
+static void lines_oit_prepare_stats(const void *opaque, sl_prepare_stats *out)
+{
+    const lines_oit_state *s = opaque;
+    *out = s ? s->prep : (sl_prepare_stats){0};
+}
+
 static size_t lines_oit_gpu_bytes(const void *opaque)
 {
     const lines_oit_state *s = opaque;
@@ -278,4 +297,5 @@ const sl_technique sl_lines_oit_technique = {
     .render = lines_oit_render,
     .release = lines_oit_release,
     .gpu_bytes = lines_oit_gpu_bytes,
+    .prepare_stats = lines_oit_prepare_stats,
 };

@@ -7,7 +7,9 @@
  * each segment into two quadratic Beziers and emits their oriented boxes,
  * tubes.frag.glsl finds the nearest sphere-sweep entry per pixel. A camera
  * move re-uploads nothing; radius, colour and root-search parameters are
- * uniforms (an attribute change re-fills the small scalar buffer). Does not
+ * uniforms (an attribute change re-fills the small scalar buffer; a
+ * radius_attribute change re-prepares: radii live in the node buffer). An
+ * attribute index the dataset lacks is an error (sl_line_style_check). Does not
  * do transparency or level of detail. Render thread only (GL).
  */
 #include <stdlib.h>
@@ -19,15 +21,17 @@
 #include "../gpu/sl_gpu.h"
 #include "tubes_nodes.h"
 
-static const char *const root_methods[] = {"bisection", "illinois", NULL};
+static const char *const root_methods[] = {"bisection", "illinois", "newton", NULL};
 static const char *const tangent_modes[] = {"auto", "catmull_rom", "data_exact", NULL};
 
 static const sl_param_def tubes_params[] = {
     SL_LINE_STYLE_PARAMS,
+    SL_LINE_STYLE_RADIUS_ATTRIBUTE_PARAM,
     {"iterations", SL_PARAM_INT, 1, 64, {20}, NULL, "",
      "steps of every root search (the accuracy knob)", SL_INVALIDATE_FRAME},
     {"root_method", SL_PARAM_ENUM, 0, 0, {1}, root_methods, "",
-     "root search: bisection (as in the paper) or Illinois regula falsi (default: same error in fewer steps)",
+     "root search: bisection (as in the paper), Illinois regula falsi (default), or newton (safeguarded Newton; "
+     "Illinois in a smoothing variable for the entry-distance derivative): fewer steps for the same error",
      SL_INVALIDATE_FRAME},
     {"tangents", SL_PARAM_ENUM, 0, 0, {0}, tangent_modes, "",
      "node tangents: auto (explicit Hermite data exactly, data tangent directions with Catmull-Rom length, else Catmull-Rom), catmull_rom, or the data's as they are", SL_INVALIDATE_PREPARED},
@@ -80,10 +84,13 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     s->dataset = ds;
     s->colormap_loaded = -1;
     s->attribute_loaded = -2;
-    sl_status st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1,
-                                        &s->nodes, err);
+    sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK)
         goto fail;
+    st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1, &s->nodes, err);
+    if (st != SL_OK)
+        goto fail;
+    sl_tubes_nodes_set_radii(&ds->lines, sl_params_int(params, "radius_attribute"), &s->nodes);
     if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
                                                       .geometry = "tubes/tubes.geom.glsl",
                                                       .fragment = "tubes/tubes.frag.glsl",
@@ -160,8 +167,11 @@ static void set_uniforms(GLuint program, const sl_line_style *style, const sl_pa
 static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                               sl_render_stats *stats, sl_err *err)
 {
-    (void)target; (void)err;
+    (void)target;
     tubes_state *s = opaque;
+    sl_status st = sl_line_style_check(params, s->dataset, err);
+    if (st != SL_OK)
+        return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
     if (style.colormap != s->colormap_loaded) {

@@ -4,8 +4,9 @@
 // off x (any orthogonal vector when collinear), z = x cross y; extents from the analytic
 // extrema of q -+ r of both sign combinations, so negative radius splines stay covered.
 // Only faces whose plane has the eye outside are emitted (at most 3, each pixel once); when
-// the eye is inside a box, one full-screen quad at the near depth is emitted instead, so
-// the fragment depth never exceeds the raster depth (layout(depth_less) holds).
+// the eye is inside a box, or the near plane cuts it (its eye-facing faces would be clipped
+// where rays enter), one full-screen quad at the near depth is emitted instead, so the
+// fragment depth never exceeds the raster depth (layout(depth_less) holds).
 #include "gpu/glsl/camera.glsl"
 
 layout(lines) in;
@@ -104,7 +105,14 @@ void emit_box(vec3 b0, vec3 b1, vec3 b2, vec3 r, vec3 c)
     }
     vec3 eye = transpose(axes) * sl_eye.xyz;
     bool inside = all(greaterThan(eye, lo)) && all(lessThan(eye, hi));
-    if (inside) {
+    // A box that the near plane cuts (some corners before it, some beyond;
+    // reversed-Z: z > w is before the near plane or behind the eye) loses the
+    // clipped part of its eye-facing faces, and rays entering the box there
+    // would see nothing: treat it as "eye inside" too.
+    int before_near = 0;
+    for (int i = 0; i < 8; i++)
+        before_near += clip[i].z > clip[i].w ? 1 : 0;
+    if (inside || (before_near > 0 && before_near < 8)) {
         emit_screen(b0, b1, b2, r, c);
         return;
     }

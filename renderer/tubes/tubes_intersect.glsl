@@ -9,7 +9,10 @@
 // f' (minima). Derivatives are used through sign-preserving multiples without
 // the square-root singularity: F1 = 2 sqrt(g) h' - g' ~ f', F2 = 4 g^1.5 f'',
 // F3 = 8 g^2.5 f'''. Each root search runs u_iterations steps of bisection
-// (method 0) or of the Illinois variant of regula falsi (method 1).
+// (method 0), of the Illinois variant of regula falsi (method 1), or (method 2)
+// of safeguarded Newton for g', g, F3, F2 and of Illinois for F1 in a variable
+// theta that removes F1's square-root singularity at the ends of g > 0
+// (tubes_root_f1; Newton on F1 or on f' itself converged badly there).
 
 uniform int u_iterations;
 uniform int u_method;
@@ -65,9 +68,60 @@ float tubes_eval(int which, float t)
     return 2.0 * sqrt(g) * h1 - g1;
 }
 
+// tubes_eval(which, t) for which = 0..3 and its derivative in t (for the
+// Newton steps; F1 goes through tubes_root_f1). g'''' is the constant
+// 24 (R2^2 - Y2^2 - Z2^2) of the quadratics' t^2 coefficients;
+// F3' = -2 g g' g''' - 4 g^2 g'''' + 6 g g''^2 - 3 g'^2 g'',
+// F2' = 6 sqrt(g) g' h'' - 2 g g''' (h''' = 0).
+float tubes_eval_d(int which, float t, out float deriv)
+{
+    float g1 = poly_g1(t), g2 = poly_g2(t);
+    if (which == 0) { deriv = g2; return g1; }
+    float g = poly_g(t);
+    if (which == 1) { deriv = g1; return g; }
+    g = max(g, 0.0);
+    float g3 = poly_g3(t);
+    if (which == 2) {
+        float g4 = 24.0 * (QR.z * QR.z - QY.z * QY.z - QZ.z * QZ.z);
+        deriv = -2.0 * g * g1 * g3 - 4.0 * g * g * g4 + 6.0 * g * g2 * g2 - 3.0 * g1 * g1 * g2;
+        return -4.0 * g * g * g3 + 6.0 * g * g1 * g2 - 3.0 * g1 * g1 * g1;
+    }
+    float sg = sqrt(g);
+    deriv = 6.0 * sg * g1 * H1[1] - 2.0 * g * g3;
+    return 4.0 * g * sg * H1[1] - 2.0 * g * g2 + g1 * g1;
+}
+
 // Root of tubes_eval(which) in [a, b] given values of opposite sign at the ends.
 float tubes_root(int which, float a, float b, float fa, float fb)
 {
+    if (u_method == 2) {
+        // Safeguarded Newton (g', g, F3, F2: polynomials in t and sqrt(g)
+        // without singularity): start at the regula falsi point of the
+        // bracket (free: fa, fb are known); each step evaluates f and f'
+        // once, shrinks the bracket by the sign of f and takes the Newton
+        // step, or the bracket's midpoint when that step leaves the bracket
+        // (or f' = 0). Stops after a Newton step below 1e-7 (quadratic
+        // convergence: the next one would be far below float resolution).
+        float x = (a * fb - b * fa) / (fb - fa);
+        if (!(x > a && x < b))
+            x = 0.5 * (a + b);
+        for (int i = 0; i < u_iterations; i++) {
+            float d;
+            float fx = tubes_eval_d(which, x, d);
+            if (fx == 0.0)
+                return x;
+            if ((fx < 0.0) == (fa < 0.0)) { a = x; fa = fx; } else { b = x; fb = fx; }
+            float xn = d != 0.0 ? x - fx / d : a - 1.0;
+            bool newton = xn > a && xn < b;
+            if (!newton)
+                xn = 0.5 * (a + b);
+            float step = abs(xn - x);
+            x = xn;
+            if (b - a <= 1e-7 || (newton && step <= 1e-7))
+                break;
+        }
+        return x;
+    }
     if (u_method == 0) {
         for (int i = 0; i < u_iterations; i++) {
             float m = 0.5 * (a + b);
@@ -98,6 +152,59 @@ float tubes_root(int which, float a, float b, float fa, float fb)
             break;
     }
     return m;
+}
+
+// Root of F1 in [lo, hi], a piece of the g > 0 interval [A, B], in the
+// variable theta of t = A + (B - A) sin^2(theta / 2), theta in [0, pi]: where g
+// has a root at A or B, sqrt(g) ~ sin theta is smooth in theta, while in t F1
+// has the infinite slope of a square root there. Both maps are written from
+// the nearer end (sin^2 of a half angle, asin of a square root) so that float
+// keeps the resolution of t near A and B.
+float tubes_theta_of(float A, float B, float t)
+{
+    float w = B - A;
+    float u = clamp((t - A) / w, 0.0, 1.0);
+    return u <= 0.5 ? 2.0 * asin(sqrt(u)) : 3.14159265 - 2.0 * asin(sqrt(clamp((B - t) / w, 0.0, 1.0)));
+}
+float tubes_t_of(float A, float B, float x)
+{
+    float w = B - A;
+    if (x <= 1.57079633) {
+        float s = sin(0.5 * x);
+        return A + w * s * s;
+    }
+    float s = sin(0.5 * (3.14159265 - x));
+    return B - w * s * s;
+}
+float tubes_root_f1(float A, float B, float lo, float hi, float flo, float fhi)
+{
+    float a = tubes_theta_of(A, B, lo), b = tubes_theta_of(A, B, hi);
+    float fa = flo, fb = fhi;
+    float x = (a * fb - b * fa) / (fb - fa);
+    if (!(x > a && x < b))
+        x = 0.5 * (a + b);
+    int side = 0;
+    for (int i = 0; i < u_iterations; i++) {
+        float fx = tubes_eval(4, tubes_t_of(A, B, x));
+        if (fx == 0.0)
+            break;
+        if ((fx < 0.0) == (fa < 0.0)) {
+            a = x; fa = fx;
+            if (side == -1) fb *= 0.5;
+            side = -1;
+        } else {
+            b = x; fb = fx;
+            if (side == 1) fa *= 0.5;
+            side = 1;
+        }
+        // The next point, also after the last step (no evaluation needed).
+        x = (a * fb - b * fa) / (fb - fa);
+        if (!(x > a && x < b))
+            x = 0.5 * (a + b);
+        if (b - a <= 1e-7)
+            break;
+    }
+    return tubes_t_of(A, B, x);
 }
 
 // Inserts the root of `which` on each piece between sorted knots k[0..n)
@@ -208,7 +315,8 @@ bool tubes_intersect(vec3 q0, vec3 q1, vec3 q2, vec3 rc, vec3 d, float l_min, ou
         for (int e = 0; e + 1 < m2; e++) {
             float fb = tubes_eval(4, k1[e + 1]);
             if (fa < 0.0 && fb > 0.0 && nc < 4)
-                cand[nc++] = tubes_root(4, k1[e], k1[e + 1], fa, fb);
+                cand[nc++] = u_method >= 2 ? tubes_root_f1(a, b, k1[e], k1[e + 1], fa, fb)
+                                            : tubes_root(4, k1[e], k1[e + 1], fa, fb);
             fa = fb;
         }
         for (int e = 0; e < nc; e++) {

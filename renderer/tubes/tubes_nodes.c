@@ -59,6 +59,26 @@ void sl_tubes_nodes_set_color(const sl_lines *lines, int color_attribute, sl_tub
     n->color_attribute = color_attribute;
 }
 
+void sl_tubes_nodes_set_radii(const sl_lines *lines, int radius_attribute, sl_tubes_nodes *n)
+{
+    if (!n->geometry || radius_attribute < 0 || radius_attribute >= lines->attribute_count)
+        return;
+    const float *r = lines->attributes[radius_attribute].values;
+    int d = find_derivative_attribute(lines, lines->attributes[radius_attribute].name);
+    const float *dr = d >= 0 ? lines->attributes[d].values : NULL;
+    for (size_t k = 0; k < lines->line_count; k++) {
+        size_t lo = lines->line_offsets[k], hi = lines->line_offsets[k + 1];
+        for (size_t v = lo; v < hi; v++) {
+            float *g = n->geometry + v * SL_TUBES_NODE_FLOATS;
+            g[3] = isfinite(r[v]) ? fabsf(r[v]) : 0.0f;
+            g[7] = dr ? dr[v] : series_derivative(r, 1, lo, hi, v, 0);
+            if (!isfinite(g[7]))
+                g[7] = 0.0f;
+        }
+    }
+    n->has_radii = 1;
+}
+
 sl_status sl_tubes_nodes_build(const sl_lines *lines, sl_tubes_tangents tangents, int color_attribute,
                                sl_tubes_nodes *out, sl_err *err)
 {

@@ -48,6 +48,14 @@ typedef struct sl_tubes_nodes {
 sl_status sl_tubes_nodes_build(const sl_lines *lines, sl_tubes_tangents tangents, int color_attribute,
                                sl_tubes_nodes *out, sl_err *err);
 
+/* Takes the node radii from per-vertex attribute `radius_attribute` instead
+ * of lines->radii: r = |value| (non-finite: 0) and dr from the attribute
+ * "<name>_derivative" when the data has it, else Catmull-Rom finite
+ * differences along each line (one-sided at the ends); sets has_radii.
+ * -1 or an index the lines lack changes nothing. Needs out->geometry (call
+ * before the geometry is freed). */
+void sl_tubes_nodes_set_radii(const sl_lines *lines, int radius_attribute, sl_tubes_nodes *out);
+
 /* Refills out->color from another attribute (-1: zeros). */
 void sl_tubes_nodes_set_color(const sl_lines *lines, int color_attribute, sl_tubes_nodes *out);
 

@@ -3,13 +3,15 @@
  * The tessellation baseline of the spline-tube (Russig et al.) and voxel-line
  * (Kanzler et al.) papers, and the first thing a user sees. prepare builds
  * the mesh on the CPU (tubes_mesh_build.c) and uploads it once; the radius
- * and every shading parameter are uniforms, so only `sides` and `caps`
- * re-prepare. One indexed draw per frame. `opacity` (shared by name with
+ * and every shading parameter are uniforms, so only `sides`, `caps` and
+ * `radius_attribute` (per-vertex radii |value| from an attribute, baked into
+ * the mesh like the data's own radii) re-prepare. One indexed draw per frame. `opacity` (shared by name with
  * voxel_lines and lines_oit) is 1 = opaque; below 1 the front halves of the
  * tubes are blended in draw order without sorting and without depth writes —
  * order-dependent and only approximate where tubes overlap (lines_oit is the
  * sorted reference). Render thread only.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,6 +23,7 @@
 
 static const sl_param_def tubes_mesh_params[] = {
     SL_LINE_STYLE_PARAMS,
+    SL_LINE_STYLE_RADIUS_ATTRIBUTE_PARAM,
     {"sides", SL_PARAM_INT, 6, 30, {12}, NULL, "", "vertices per cross-section", SL_INVALIDATE_PREPARED},
     {"caps", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "close tube ends with flat caps", SL_INVALIDATE_PREPARED},
     {"opacity", SL_PARAM_FLOAT, 0.0, 1.0, {1.0}, NULL, "",
@@ -37,6 +40,7 @@ typedef struct tubes_mesh_state {
     GLsizei index_count;
     size_t gpu_bytes;
     size_t triangles;
+    sl_prepare_stats prep;      /* mesh build (CPU) and upload times */
 } tubes_mesh_state;
 
 static void tubes_mesh_release(void *opaque)
@@ -65,13 +69,35 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     s->dataset = ds;
     s->colormap_loaded = -1;
     s->attribute_loaded = -2;
-    sl_tube_mesh mesh;
-    sl_status st = sl_tube_mesh_build(&ds->lines, sl_params_int(params, "sides"),
-                                      sl_params_bool(params, "caps"), &mesh, err);
+    sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK) {
         free(s);
         return st;
     }
+    sl_line_style style;
+    sl_line_style_read(params, ds, &style);
+    double t_build = sl_now_ms();
+    sl_lines lines = ds->lines; /* a view: only the radii may differ */
+    float *attribute_radii = NULL;
+    if (style.radius_attribute >= 0) {
+        attribute_radii = malloc((ds->lines.vertex_count ? ds->lines.vertex_count : 1) * sizeof *attribute_radii);
+        if (!attribute_radii) {
+            free(s);
+            return sl_err_set(err, SL_ERR_NOMEM, "tubes_mesh: out of memory for %zu radii", ds->lines.vertex_count);
+        }
+        const float *v = ds->lines.attributes[style.radius_attribute].values;
+        for (size_t i = 0; i < ds->lines.vertex_count; i++)
+            attribute_radii[i] = isfinite(v[i]) ? fabsf(v[i]) : 0.0f;
+        lines.radii = attribute_radii;
+    }
+    sl_tube_mesh mesh;
+    st = sl_tube_mesh_build(&lines, sl_params_int(params, "sides"), sl_params_bool(params, "caps"), &mesh, err);
+    free(attribute_radii);
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
+    s->prep.preprocess_ms = sl_now_ms() - t_build;
     st = sl_gl_program_create(&(sl_program_desc){
         .vertex = "tubes_mesh/tubes_mesh.vert.glsl",
         .fragment = "tubes_mesh/tubes_mesh.frag.glsl",
@@ -81,6 +107,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
         tubes_mesh_release(s);
         return st;
     }
+    double t_upload = sl_now_ms();
     glCreateBuffers(1, &s->vbo);
     /* Empty meshes still get a (1-element) buffer so the VAO is complete. */
     glNamedBufferStorage(s->vbo, (GLsizeiptr)((mesh.vertex_count ? mesh.vertex_count : 1) * sizeof(sl_tube_vertex)),
@@ -116,6 +143,8 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     s->gpu_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t) +
                    (ds->lines.vertex_count + 1) * sizeof(float) + SL_COLORMAP_TEXELS * 4;
     sl_tube_mesh_deinit(&mesh);
+    glFinish();
+    s->prep.upload_ms = sl_now_ms() - t_upload;
     *out = s;
     return SL_OK;
 }
@@ -123,8 +152,11 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
 static sl_status tubes_mesh_render(void *opaque, const sl_view *view, const sl_params *params,
                                    sl_target *target, sl_render_stats *stats, sl_err *err)
 {
-    (void)target; (void)err;
+    (void)target;
     tubes_mesh_state *s = opaque;
+    sl_status st = sl_line_style_check(params, s->dataset, err);
+    if (st != SL_OK)
+        return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
     if (style.colormap != s->colormap_loaded) {
@@ -175,6 +207,12 @@ static sl_status tubes_mesh_render(void *opaque, const sl_view *view, const sl_p
     return SL_OK;
 }
 
+static void tubes_mesh_prepare_stats(const void *opaque, sl_prepare_stats *out)
+{
+    const tubes_mesh_state *s = opaque;
+    *out = s ? s->prep : (sl_prepare_stats){0};
+}
+
 static size_t tubes_mesh_gpu_bytes(const void *opaque)
 {
     const tubes_mesh_state *s = opaque;
@@ -191,4 +229,5 @@ const sl_technique sl_tubes_mesh_technique = {
     .render = tubes_mesh_render,
     .release = tubes_mesh_release,
     .gpu_bytes = tubes_mesh_gpu_bytes,
+    .prepare_stats = tubes_mesh_prepare_stats,
 };

@@ -91,6 +91,7 @@ typedef struct voxel_lines_state {
     int built_attribute;        /* attribute index of the uploaded attribute bytes, or -1 */
     size_t voxel_count, line_count, grid_bytes;
     double build_ms;
+    sl_prepare_stats prep;      /* timings of the last build_and_upload */
     size_t dropped_overflow, capped_voxels;
     GLuint program, ao_program, density_program, vao, camera_ubo, colormap_tex;
     GLuint offsets_buf, counts_buf, lines_buf, density_tex, ao_tex, occupancy_tex, reps_buf;
@@ -255,10 +256,17 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     sl_voxel_grid g;
     sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = s->padding,
                                .max_per_voxel = s->max_per_voxel, .attribute = attribute};
+    double t_build = sl_now_ms();
     sl_status st = s->use_gpu ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
                               : sl_voxel_grid_build(&g, s->dataset, &desc, err);
     if (st != SL_OK)
         return st;
+    double t_pack = sl_now_ms();
+    s->prep = (sl_prepare_stats){0};
+    if (s->use_gpu)
+        s->prep.gpu_ms = t_pack - t_build; /* compute passes + readback */
+    else
+        s->prep.preprocess_ms = t_pack - t_build;
     release_grid(s);
     counters.builds++;
     s->frame = g.frame;
@@ -299,6 +307,8 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
                           "voxel_lines: a %zu-byte buffer exceeds the GPU's shader storage block limit of %lld bytes; "
                           "lower `grid` or `quantization`", biggest, (long long)max_block);
     }
+    double t_upload = sl_now_ms();
+    s->prep.preprocess_ms += t_upload - t_pack; /* packing the counts and lines */
     s->offsets_buf = make_buffer(g.offsets, g.voxel_count * sizeof(uint32_t));
     s->counts_buf = make_buffer(packed, count_words * sizeof(uint32_t));
     s->lines_buf = make_buffer(words, line_words * sizeof(uint32_t));
@@ -336,8 +346,12 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     s->ao_valid = 0;
     s->density_valid = 0;
     st = upload_occupancy(s, g.counts, err);
+    glFinish();
+    double t_reps = sl_now_ms();
+    s->prep.upload_ms = t_reps - t_upload;
     if (st == SL_OK)
-        st = upload_representatives(s, &g, err);
+        st = upload_representatives(s, &g, err); /* mostly the CPU LoD build */
+    s->prep.preprocess_ms += sl_now_ms() - t_reps;
     s->ready = st == SL_OK;
     if (st == SL_OK && g.dropped_overflow)
         fprintf(stderr, "voxel_lines: %zu lines dropped in %zu voxels above the %d-line header limit "
@@ -371,10 +385,15 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     s->resolution = sl_params_int(params, "grid");
     int build = sl_params_choice(params, "voxelize");
     s->use_gpu = build == 2 || (build == 0 && !sl_gpu_is_software(gpu));
+    sl_status st = sl_line_style_check(params, ds, err);
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
     sl_voxel_frame probe;
-    sl_status st = sl_voxel_frame_init(&probe, ds, s->resolution, 1, err); /* h does not depend on padding */
+    st = sl_voxel_frame_init(&probe, ds, s->resolution, 1, err); /* h does not depend on padding */
     if (st != SL_OK) {
         free(s);
         return st;
@@ -477,6 +496,9 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
 {
     (void)target;
     voxel_lines_state *s = opaque;
+    sl_status st = sl_line_style_check(params, s->dataset, err);
+    if (st != SL_OK)
+        return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
     /* Rebuild (re-voxelize) when the attribute bytes change, or when the
@@ -600,7 +622,14 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     glBindVertexArray(0);
     glDisable(GL_BLEND);
     stats->primitives = (double)view->width * view->height;
+    stats->dropped = (double)s->dropped_overflow;
     return SL_OK;
+}
+
+static void voxel_lines_prepare_stats(const void *opaque, sl_prepare_stats *out)
+{
+    const voxel_lines_state *s = opaque;
+    *out = s ? s->prep : (sl_prepare_stats){0};
 }
 
 static size_t voxel_lines_gpu_bytes(const void *opaque)
@@ -619,4 +648,5 @@ const sl_technique sl_voxel_lines_technique = {
     .render = voxel_lines_render,
     .release = voxel_lines_release,
     .gpu_bytes = voxel_lines_gpu_bytes,
+    .prepare_stats = voxel_lines_prepare_stats,
 };

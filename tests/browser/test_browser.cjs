@@ -175,6 +175,14 @@ async function main() {
       null, { timeout: T }).catch(() => {});
     const attrs = await page.$$eval('#params select[name=attribute] option', (os) => os.map((o) => o.textContent));
     check(attrs[0] === 'none' && attrs.length > 1, `attribute control lists the dataset's attributes ${JSON.stringify(attrs)}`);
+    // radius_attribute (techniques with per-vertex radii) is a select of the same names.
+    const radiusAttrs = await page.$$eval('#params select[name=radius_attribute] option', (os) => os.map((o) => o.textContent));
+    const [tech, schemaHasRadiusAttr] = await page.evaluate(() => {
+      const t = window.sightline.techniques.find((x) => x.name === window.sightline.state.technique);
+      return [t.name, t.params.some((p) => p.name === 'radius_attribute')];
+    });
+    check(schemaHasRadiusAttr ? JSON.stringify(radiusAttrs) === JSON.stringify(attrs) : radiusAttrs.length === 0,
+      `${tech}: radius_attribute control (in schema: ${schemaHasRadiusAttr}) lists ${JSON.stringify(radiusAttrs)}`);
 
     // 3b. Snapshot button downloads a PNG; a named view is saved and listed.
     const [download] = await Promise.all([page.waitForEvent('download', { timeout: T }), page.click('#snapshot')]);

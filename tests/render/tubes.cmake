@@ -5,8 +5,10 @@
 # Scenes and goldens live in tests/render/tubes/.
 #
 # Bound (every accuracy test): on pixels both hit, |depth error| <= 1e-3 x the
-# local sweep radius; exceptions (beyond it, or hit by one side only) only at
-# reference silhouettes and <= 0.5 % of the pixels hit; no NaN/Inf.
+# local sweep radius; exceptions only at reference silhouettes (coverage change
+# or a depth jump of more than the radius in 3x3; joints are not silhouettes):
+# a pixel hit by one side only, or a depth error <= 0.05 x the radius (the
+# float32 rim bound), together <= 0.5 % of the pixels hit; no NaN/Inf.
 set(TUBES_DIR ${CMAKE_CURRENT_SOURCE_DIR}/tubes)
 set(TUBES_OUT ${SL_RENDER_OUT}/tubes)
 file(MAKE_DIRECTORY ${TUBES_OUT})
@@ -59,8 +61,60 @@ tubes_render_test(accuracy.random_thin_close
 
 # Numerical stress scenes and the golden-image scenes, each against the reference.
 foreach(name stress_zero_length stress_zero_tangents stress_collinear stress_radius_zero_end stress_big_radius
-             stress_offset stress_grazing stress_inside bifurcation sharp_corner varying_radius)
+             stress_offset stress_grazing stress_inside stress_near_plane bifurcation sharp_corner varying_radius)
   tubes_render_test(accuracy.${name} tubes-check --scene ${TUBES_DIR}/${name}.json)
+endforeach()
+# The root methods at the default iterations on the thin-tube scene (the
+# default method is covered by every test above).
+foreach(method bisection illinois newton)
+  tubes_render_test(accuracy.random_thin_${method}
+    tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 9 --set params.radius_scale=0.15
+    --set camera.orbit.distance=0.5 --set params.root_method=${method})
+endforeach()
+# Data derivatives as they are (tornado velocities as tangents, not only their
+# direction): no NaN, the same bound.
+tubes_render_test(accuracy.tornado_data_exact
+  tubes-check --scene ${TUBES_DIR}/tornado.json --set params.tangents=data_exact)
+# Frustum culling: a close view with part of the data outside the frustum
+# draws fewer primitives with culling than without, and not one pixel differs
+# (distance and colour); toggling it re-prepares nothing.
+tubes_render_test(culling.fewer_primitives_same_image
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 6 --set camera.orbit.distance=0.6
+  --culling-check)
+
+# Radii from a data attribute (shared line-style parameter radius_attribute):
+# the varying-radius tube with its radii moved into the colour scalar, drawn
+# with radius_attribute 0 by sightline-render, must match the reference of
+# radius_attribute_ref.json (varying_radius.json: radii from the nodes' r and dr).
+tubes_render_test(accuracy.radius_attribute
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/radius_attribute.json|--out|${TUBES_OUT}/radius_attribute.png|--depth|${TUBES_OUT}/radius_attribute.pfm|--samples|1"
+  "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/radius_attribute_ref.json|--gpu-depth|${TUBES_OUT}/radius_attribute.pfm"
+  -P ${TUBES_DIR}/run_steps.cmake)
+# An attribute index the dataset lacks is an error naming the parameter and
+# the number of attributes (explicit Hermite data has 3: scalar,
+# scalar_derivative, radius_derivative), not a silent constant colour.
+foreach(param attribute radius_attribute)
+  tubes_render_test(bad_${param}
+    $<TARGET_FILE:sightline-render> --scene ${TUBES_DIR}/varying_radius.json --out ${TUBES_OUT}/bad_${param}.png
+    --set params.${param}=3)
+  set_tests_properties(render.tubes.bad_${param} PROPERTIES
+    PASS_REGULAR_EXPRESSION "params\\.${param} = 3: the dataset has 3 per-vertex attributes")
+endforeach()
+
+# The checks can fail (EXPECT_FAIL_STEP: that step must exit 1, "check failed"):
+# a radius 0.15 % too large, rendered by sightline-render and checked against
+# the reference of the scene as it is, and a single root-search step.
+tubes_render_test(detects.radius_scale_1_0015
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/varying_radius.json|--out|${TUBES_OUT}/vr_thick.png|--depth|${TUBES_OUT}/vr_thick.pfm|--samples|1|--set|params.radius_scale=1.0015"
+  "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--gpu-depth|${TUBES_OUT}/vr_thick.pfm"
+  -DEXPECT_FAIL_STEP=2 -P ${TUBES_DIR}/run_steps.cmake)
+foreach(method bisection illinois newton)
+  tubes_render_test(detects.iterations_1_${method}
+    ${CMAKE_COMMAND}
+    "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--set|params.iterations=1|--set|params.root_method=${method}"
+    -DEXPECT_FAIL_STEP=1 -P ${TUBES_DIR}/run_steps.cmake)
 endforeach()
 
 # The command-line path of the issue: sightline-render --depth, then the
@@ -80,6 +134,34 @@ tubes_render_test(accuracy.hotroom_cli
   "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/hotroom.json|--out|${TUBES_OUT}/hotroom.png|--depth|${TUBES_OUT}/hotroom_gpu.pfm|--samples|1"
   "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/hotroom.json|--gpu-depth|${TUBES_OUT}/hotroom_gpu.pfm|--out-ref|${TUBES_OUT}/hotroom_ref.pfm"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/hotroom_gpu.pfm|${TUBES_OUT}/hotroom_ref.pfm|--bad-threshold|2.4e-5|--max-bad-pct|0.5|--max-coverage-pct|0.5"
+  -P ${TUBES_DIR}/run_steps.cmake)
+
+# Every stress scene (and a random set, written out by tubes-check
+# --write-scene) through the command-line path as well: sightline-render
+# --depth, the strict check on that PFM (tubes-check --gpu-depth, local radius,
+# silhouette rule), then sightline-diff of the GPU PFM against the reference
+# PFM with an absolute bound of 1e-3 x the scene's smallest non-zero node
+# radius and 0.5 % bad / coverage allowance (sightline-diff knows no radii or
+# silhouettes).
+foreach(pair stress_zero_length:1e-4 stress_zero_tangents:1e-4 stress_collinear:6e-5 stress_radius_zero_end:1.5e-4
+             stress_big_radius:3e-4 stress_offset:5e-5 stress_grazing:8e-5 stress_inside:1e-4 stress_near_plane:5e-5)
+  string(REPLACE ":" ";" pair "${pair}")
+  list(GET pair 0 name)
+  list(GET pair 1 bound)
+  tubes_render_test(accuracy.${name}_cli
+    ${CMAKE_COMMAND}
+    "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/${name}.json|--out|${TUBES_OUT}/${name}_cli.png|--depth|${TUBES_OUT}/${name}_gpu.pfm|--samples|1"
+    "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/${name}.json|--gpu-depth|${TUBES_OUT}/${name}_gpu.pfm|--out-ref|${TUBES_OUT}/${name}_ref.pfm"
+    "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}_gpu.pfm|${TUBES_OUT}/${name}_ref.pfm|--bad-threshold|${bound}|--max-bad-pct|0.5|--max-coverage-pct|0.5"
+    -P ${TUBES_DIR}/run_steps.cmake)
+endforeach()
+# A random set (radii 0.03-0.12): the scene as tubes-check builds it, rendered by sightline-render.
+tubes_render_test(accuracy.random_1_cli
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/random.json|--random-segments|40|--seed|1|--write-scene|${TUBES_OUT}/random_1_scene.json|--out-ref|${TUBES_OUT}/random_1_ref.pfm"
+  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_OUT}/random_1_scene.json|--out|${TUBES_OUT}/random_1_cli.png|--depth|${TUBES_OUT}/random_1_gpu.pfm|--samples|1"
+  "-DSTEP3=$<TARGET_FILE:tubes-check>|--scene|${TUBES_OUT}/random_1_scene.json|--gpu-depth|${TUBES_OUT}/random_1_gpu.pfm"
+  "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/random_1_gpu.pfm|${TUBES_OUT}/random_1_ref.pfm|--bad-threshold|3e-5|--max-bad-pct|0.5|--max-coverage-pct|0.5"
   -P ${TUBES_DIR}/run_steps.cmake)
 
 # Golden images (128x128, llvmpipe): mean colour difference <= 1 and at most

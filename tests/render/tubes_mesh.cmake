@@ -158,7 +158,8 @@ endforeach()
 
 # ---- 5. command line.
 # --frames 3 --stats: renderer, technique, frames, gpu_ms / wall_ms {min, median,
-# max}, dataset_load_ms (generation), prepare_ms (mesh build + upload),
+# max}, dataset_load_ms (generation), prepare_ms, its parts preprocess_ms (mesh
+# build) and upload_ms,
 # gpu_bytes, primitives = 100 lines x 199 segments x 12 sides x 2 + 100 x 2 caps x 12.
 tm_test(cli.stats ${CMAKE_COMMAND}
   "-DSTEP1=${TM_RENDER}|--scene|${TM_DIR}/tornado.json|--out|${TM_OUT}/stats.png|--frames|3|--stats|${TM_OUT}/stats.json"
@@ -238,3 +239,21 @@ tm_test(selftest.jpeg_detects_other_picture ${CMAKE_COMMAND}
   "-DSTEP2=${TM_CHECK}|image|--scene|${TM_DIR}/tornado.json|--jpeg|${TM_OUT}/st_frame.jpg|--png|${TM_DIR}/golden/hotroom.png"
   -DEXIT2=1 "-DERR2=the JPEG differs from [^\n]*hotroom\\.png by [0-9.]+ on average"
   ${TM_STEPS})
+
+# ---- 6. radii from an attribute (radius_attribute, shared with tubes): the
+# varying-radius Hermite scene with its radii moved into the colour scalar,
+# meshed with radius_attribute 0, gives the same surface as the scene with
+# the radii as data radii (the same radii; the two datasets' origins differ,
+# as their bounds include the radii, so positions round differently: 1e-4 of
+# a depth of ~2.7 is ~20 float ulps), and a frame without it (the constant
+# 0.01) differs beyond that.
+tm_test(radius_attribute ${CMAKE_COMMAND}
+  "-DSTEP1=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute_ref.json|--set|technique=tubes_mesh|--out|${TM_OUT}/ra_ref.png|--depth|${TM_OUT}/ra_ref.pfm"
+  "-DSTEP2=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute.json|--set|technique=tubes_mesh|--out|${TM_OUT}/ra_attr.png|--depth|${TM_OUT}/ra_attr.pfm"
+  "-DSTEP3=${TM_DIFF}|${TM_OUT}/ra_attr.pfm|${TM_OUT}/ra_ref.pfm|--max-abs|1e-4|--max-coverage-pct|0"
+  ${TM_STEPS})
+tm_test(radius_attribute_changes_depth ${CMAKE_COMMAND}
+  "-DSTEP1=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute_ref.json|--set|technique=tubes_mesh|--out|${TM_OUT}/rb_ref.png|--depth|${TM_OUT}/rb_ref.pfm"
+  "-DSTEP2=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute.json|--set|technique=tubes_mesh|--set|params.radius_attribute=-1|--out|${TM_OUT}/rb_attr.png|--depth|${TM_OUT}/rb_attr.pfm"
+  "-DSTEP3=${TM_DIFF}|${TM_OUT}/rb_attr.pfm|${TM_OUT}/rb_ref.pfm|--max-abs|1e-4|--max-coverage-pct|0"
+  -DEXIT3=1 ${TM_STEPS})

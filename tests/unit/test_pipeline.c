@@ -99,7 +99,9 @@ static int move_param(sl_params *p, int i, sl_err *err)
         break;
     }
     case SL_PARAM_INT:
-        v[0] = v[0] + 1.0 <= d->max ? v[0] + 1.0 : v[0] - 1.0;
+        /* Down first: index parameters (attribute 0 -> -1) stay valid on
+         * a dataset with one attribute. */
+        v[0] = v[0] - 1.0 >= d->min ? v[0] - 1.0 : v[0] + 1.0;
         break;
     case SL_PARAM_FLOAT:
         v[0] = moved_number(d, v[0]);

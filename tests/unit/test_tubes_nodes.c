@@ -5,8 +5,10 @@
  * tangent modes with data tangents; segments per line; explicit Hermite JSON
  * round trip (exact tangents and derivatives, bifurcations, sharp corners,
  * 1e5 offsets kept to float precision relative to the origin); and that every
- * malformed document is refused with a message naming the field.
+ * malformed document is refused with a message naming the field; radii from
+ * a per-vertex attribute (sl_tubes_nodes_set_radii).
  */
+#include <stdlib.h>
 #include <string.h>
 
 #include "sl_test.h"
@@ -153,10 +155,52 @@ static void test_json(void)
     sl_dataset_destroy(ds);
 }
 
+/* Radii from a per-vertex attribute (the shared radius_attribute parameter):
+ * r = |value|, dr by finite differences within each line, or from the
+ * attribute's "_derivative" companion; -1 and a missing index change nothing. */
+static void test_radius_attribute(void)
+{
+    sl_err err;
+    sl_dataset *ds = three_points(0);
+    sl_tubes_nodes n;
+    SL_CHECK(sl_tubes_nodes_build(&ds->lines, SL_TUBES_TANGENTS_AUTO, -1, &n, &err) == SL_OK);
+    sl_tubes_nodes_set_radii(&ds->lines, -1, &n);
+    SL_CHECK_NEAR(n.geometry[SL_TUBES_NODE_FLOATS + 3], 2, 0); /* lines->radii kept */
+    sl_tubes_nodes_set_radii(&ds->lines, 7, &n);
+    SL_CHECK_NEAR(n.geometry[SL_TUBES_NODE_FLOATS + 3], 2, 0);
+    ds->lines.attributes[0].values[3] = -5.0f; /* |value| */
+    sl_tubes_nodes_set_radii(&ds->lines, 0, &n);
+    SL_CHECK(n.has_radii == 1);
+    const float *g = n.geometry;
+    SL_CHECK_NEAR(g[3], 0, 0); SL_CHECK_NEAR(g[7], 10, 0);                  /* one-sided: 10 - 0 */
+    g = n.geometry + SL_TUBES_NODE_FLOATS;
+    SL_CHECK_NEAR(g[3], 10, 0); SL_CHECK_NEAR(g[7], 15, 0);                 /* (30 - 0) / 2 */
+    g = n.geometry + 3 * SL_TUBES_NODE_FLOATS;
+    SL_CHECK_NEAR(g[3], 5, 0); SL_CHECK_NEAR(g[7], 12, 0);                  /* line 1 alone: 7 - (-5) */
+    sl_tubes_nodes_deinit(&n);
+    /* without lines->radii, and with a derivative companion */
+    free(ds->lines.radii);
+    ds->lines.radii = NULL;
+    float *d = sl_lines_add_attribute(&ds->lines, "speed" SL_ATTR_DERIVATIVE_SUFFIX, 0, &err);
+    SL_CHECK(d != NULL);
+    if (d)
+        for (int v = 0; v < 5; v++)
+            d[v] = 0.5f * (float)v;
+    SL_CHECK(sl_tubes_nodes_build(&ds->lines, SL_TUBES_TANGENTS_AUTO, -1, &n, &err) == SL_OK);
+    SL_CHECK(n.has_radii == 0);
+    sl_tubes_nodes_set_radii(&ds->lines, 0, &n);
+    SL_CHECK(n.has_radii == 1);
+    SL_CHECK_NEAR(n.geometry[2 * SL_TUBES_NODE_FLOATS + 3], 30, 0);
+    SL_CHECK_NEAR(n.geometry[2 * SL_TUBES_NODE_FLOATS + 7], 1.0, 0);
+    sl_tubes_nodes_deinit(&n);
+    sl_dataset_destroy(ds);
+}
+
 int main(void)
 {
     test_catmull_rom();
     test_tangent_modes();
     test_json();
+    test_radius_attribute();
     SL_TEST_END();
 }

@@ -134,14 +134,28 @@ static void intersect_piece(const piece *pc, const ray *ry, int n, double *fs, d
     }
 }
 
-/* 16 + 16 per radius of control-polygon length, capped by desc->samples. */
-static int piece_samples(const tubes_ref_desc *desc, const sl_vec3 *cp, int n, double rmax)
+/* Samples of one piece: 16 + 16 per radius of control-polygon length, the
+ * radius being the piece's smallest |control radius| (the sweep radius never
+ * drops below it inside the piece, by the convex hull property), floored at
+ * 1/64 of the largest (a radius through 0 would ask for unbounded samples).
+ * A sphere of radius r seen by a ray is hit over a parameter range of about
+ * r / length, so this puts >= 16 samples across the narrowest hit and its
+ * discriminant maximum; 16 x len / r_max (the former rule) missed narrow hits
+ * on thin parts of long pieces. Capped by desc->samples (default
+ * TUBES_REF_MAX_SAMPLES). */
+#define TUBES_REF_MAX_SAMPLES 8192
+static int piece_samples(const tubes_ref_desc *desc, const sl_vec3 *cp, int n, const double *r)
 {
-    double len = 0.0;
+    double len = 0.0, rmin = INFINITY, rmax = 0.0;
     for (int i = 0; i + 1 < n; i++)
         len += sl_v3_length(sl_v3_sub(cp[i + 1], cp[i]));
-    int cap = desc->samples > 0 ? desc->samples : 512;
-    double want = rmax > 0.0 ? 16.0 + 16.0 * len / rmax : cap;
+    for (int i = 0; i < n; i++) {
+        rmin = fmin(rmin, fabs(r[i]));
+        rmax = fmax(rmax, fabs(r[i]));
+    }
+    int cap = desc->samples > 0 ? desc->samples : TUBES_REF_MAX_SAMPLES;
+    double rlow = fmax(rmin, rmax / 64.0);
+    double want = rlow > 0.0 ? 16.0 + 16.0 * len / rlow : cap;
     return want < cap ? (int)want : cap;
 }
 
@@ -179,7 +193,7 @@ static void make_pieces(const tubes_ref_desc *desc, piece *pcs, size_t *count)
             }
             q->centre = c;
             q->bound = bd + rm;
-            q->samples = piece_samples(desc, hull, 4, rm);
+            q->samples = piece_samples(desc, hull, 4, rh);
             k++;
             continue;
         }
@@ -202,7 +216,7 @@ static void make_pieces(const tubes_ref_desc *desc, piece *pcs, size_t *count)
             for (int i = 0; i < 3; i++)
                 bd = fmax(bd, sl_v3_length(sl_v3_sub(cp[h][i], p->centre)));
             p->bound = bd + rm;
-            p->samples = piece_samples(desc, cp[h], 3, rm);
+            p->samples = piece_samples(desc, cp[h], 3, cr[h]);
             p->segment = (int)s;
         }
     }
@@ -214,7 +228,7 @@ void tubes_ref_render(const tubes_ref_desc *desc, float *distance, float *radius
     const sl_view *v = desc->view;
     size_t cap = desc->nodes->segment_count * 2 + 1;
     piece *pcs = malloc(cap * sizeof *pcs);
-    int n = desc->samples > 0 ? desc->samples : 512;
+    int n = desc->samples > 0 ? desc->samples : TUBES_REF_MAX_SAMPLES;
     double *fs = malloc((size_t)(n + 1) * sizeof *fs), *ds = malloc((size_t)(n + 1) * sizeof *ds);
     size_t np = 0;
     if (pcs && fs && ds)
@@ -249,4 +263,21 @@ void tubes_ref_render(const tubes_ref_desc *desc, float *distance, float *radius
     free(pcs);
     free(fs);
     free(ds);
+}
+
+int tubes_ref_silhouette(const float *ref, const float *rad, int w, int h, int i, int j)
+{
+    size_t c = (size_t)j * (size_t)w + (size_t)i;
+    for (int dj = -1; dj <= 1; dj++)
+        for (int di = -1; di <= 1; di++) {
+            int x = i + di, y = j + dj;
+            if (x < 0 || y < 0 || x >= w || y >= h)
+                continue;
+            size_t n = (size_t)y * (size_t)w + (size_t)x;
+            if ((ref[n] > 0.0f) != (ref[c] > 0.0f))
+                return 1;
+            if (ref[c] > 0.0f && ref[n] > 0.0f && fabsf(ref[n] - ref[c]) > fmaxf(rad[c], rad[n]))
+                return 1;
+        }
+    return 0;
 }

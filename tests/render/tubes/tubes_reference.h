@@ -21,12 +21,20 @@ typedef struct tubes_ref_desc {
     double radius;                /* radius where the data gives none */
     double radius_scale;          /* factor on data radii */
     int cubic;                    /* 0: two quadratics per segment (the rendered surface); 1: cubic Hermite */
-    int samples;                  /* samples of t per sub-segment (0: 512) */
+    int samples;                  /* cap on samples of t per piece (0: 8192); a piece takes 16 + 16 x its
+                                     control-polygon length / its smallest radius (see piece_samples) */
 } tubes_ref_desc;
 
 /* Per pixel (rows top-down): Euclidean distance from the eye to the nearest
  * sphere entry beyond the near plane (0 = miss), the sweep radius there and
  * the segment index (-1 = miss). radius and segment may be NULL. */
 void tubes_ref_render(const tubes_ref_desc *desc, float *distance, float *radius, int *segment);
+
+/* 1 when pixel (i, j) of a reference distance map (w x h, rows top-down,
+ * 0 = miss) is at a silhouette: within its 3x3 neighbourhood the coverage
+ * changes, or the distance jumps by more than the local radius rad[] (one tube
+ * in front of another, even of the same segment). A joint between two
+ * segments of one tube is not a silhouette (the distance is continuous). */
+int tubes_ref_silhouette(const float *distance, const float *rad, int w, int h, int i, int j);
 
 #endif

@@ -49,6 +49,7 @@
  * stats: the --stats JSON of sightline-render has the renderer string, the
  *   technique, frames = N, gpu_ms and wall_ms {min, median, max} (finite,
  *   >= 0, ordered), dataset_load_ms and prepare_ms (finite, >= 0; prepare > 0),
+ *   preprocess_ms and upload_ms (> 0, each at most prepare_ms),
  *   gpu_bytes > 0 and primitives > 0 (= P when given).
  *
  * Exit: 0 pass, 1 check failed, 2 bad input, 3 GPU failure.
@@ -749,6 +750,16 @@ static int run_stats(const options *o)
         fail("stats: primitives is 0");
     if (prims && o->expect_primitives >= 0.0 && prims->valuedouble != o->expect_primitives)
         fail("stats: primitives = %.0f, expected %.0f", prims->valuedouble, o->expect_primitives);
+    /* The technique's split of prepare_ms: the mesh build and the upload,
+     * each timed (> 0) and each a part of the whole. */
+    const char *parts[] = {"preprocess_ms", "upload_ms"};
+    for (int i = 0; i < 2; i++) {
+        const cJSON *part = need_number(root, "", parts[i], 0.0);
+        if (part && !(part->valuedouble > 0.0))
+            fail("stats: %s is 0: not timed", parts[i]);
+        if (part && prep && part->valuedouble > prep->valuedouble)
+            fail("stats: %s = %g exceeds prepare_ms = %g", parts[i], part->valuedouble, prep->valuedouble);
+    }
     printf("{\"mode\": \"stats\", \"file\": \"%s\", \"pass\": %s}\n", o->stats, failures ? "false" : "true");
     cJSON_Delete(root);
     return failures ? 1 : 0;
