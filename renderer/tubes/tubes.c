@@ -52,6 +52,7 @@ typedef struct tubes_state {
     int colormap_loaded;         /* colormap index in colormap_tex, or -1 */
     int attribute_loaded;        /* attribute in color_vbo, or -2 */
     size_t gpu_bytes;
+    sl_prepare_stats prep;      /* node build (CPU) and upload times */
 } tubes_state;
 
 static void tubes_release(void *opaque)
@@ -87,10 +88,12 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK)
         goto fail;
+    double t_build = sl_now_ms();
     st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1, &s->nodes, err);
     if (st != SL_OK)
         goto fail;
     sl_tubes_nodes_set_radii(&ds->lines, sl_params_int(params, "radius_attribute"), &s->nodes);
+    s->prep.preprocess_ms = sl_now_ms() - t_build;
     if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
                                                       .geometry = "tubes/tubes.geom.glsl",
                                                       .fragment = "tubes/tubes.frag.glsl",
@@ -104,6 +107,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
                                    &s->program_silhouette, err)) != SL_OK)
         goto fail;
 
+    double t_upload = sl_now_ms();
     size_t nn = s->nodes.node_count ? s->nodes.node_count : 1;
     size_t ns = s->nodes.segment_count ? s->nodes.segment_count : 1;
     glCreateBuffers(1, &s->node_vbo);
@@ -132,6 +136,8 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glGenQueries(1, &s->query);
+    glFinish();
+    s->prep.upload_ms = sl_now_ms() - t_upload;
     s->gpu_bytes = nn * (SL_TUBES_NODE_FLOATS + 2) * sizeof(float) + ns * 2 * sizeof(uint32_t) +
                    SL_COLORMAP_TEXELS * 4;
     /* The geometry lives on the GPU now; keep only the colour scalars. */
@@ -214,6 +220,12 @@ static size_t tubes_gpu_bytes(const void *opaque)
     return s ? s->gpu_bytes : 0;
 }
 
+static void tubes_prepare_stats(const void *opaque, sl_prepare_stats *out)
+{
+    const tubes_state *st = opaque;
+    *out = st ? st->prep : (sl_prepare_stats){0};
+}
+
 const sl_technique sl_tubes_technique = {
     .name = "tubes",
     .description = "raycast Hermite spline tubes (Russig, Salm, Gumhold: GPU-based Raycasting of Hermite Spline Tubes)",
@@ -224,4 +236,5 @@ const sl_technique sl_tubes_technique = {
     .render = tubes_render,
     .release = tubes_release,
     .gpu_bytes = tubes_gpu_bytes,
+    .prepare_stats = tubes_prepare_stats,
 };

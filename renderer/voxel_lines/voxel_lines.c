@@ -18,8 +18,8 @@
  * the radius grows above 1 voxel (2 voxels of padding instead of 1). Grid
  * resolution, quantization and the per-voxel cap re-prepare. Data radii are
  * not used (one radius for all tubes). Lines dropped by the per-voxel cap
- * are reported once per build on stderr (sl_render_stats has no field for
- * them). Work counters for tests: voxel_lines.h. Render thread only.
+ * are reported once per build on stderr and in every frame's
+ * sl_render_stats.dropped. Work counters for tests: voxel_lines.h. Render thread only.
  * Limits: README.md.
  */
 #include <math.h>

@@ -84,3 +84,14 @@ endforeach()
 # tubes_mesh depth, and the same data 1e6 units from the origin: same image.
 voxel_render_test(voxel_lines.stress_faces_and_offset
   voxel-check stress --size 128 --quant 256 --tol-median 0.03 --tol-p95 0.15 --max-mismatch-pct 5)
+
+# Lines beyond the per-voxel cap are counted in sightline-render --stats
+# (`dropped`), not only on stderr: a cap of 1 line per voxel on the opaque
+# scene drops some, the default cap none.
+foreach(case "1;some" "255;none")
+  list(GET case 0 cap)
+  list(GET case 1 expect)
+  voxel_render_test(voxel_lines.stats_dropped_cap${cap}
+    ${CMAKE_COMMAND} -DRENDER=$<TARGET_FILE:sightline-render> -DSCENE=${VOXEL_DIR}/opaque.json
+    -DOUT=${SL_RENDER_OUT} -DCAP=${cap} -DEXPECT=${expect} -P ${VOXEL_DIR}/stats_dropped.cmake)
+endforeach()
