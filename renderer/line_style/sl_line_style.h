@@ -30,7 +30,8 @@ struct sl_dataset;
     {"colormap", SL_PARAM_ENUM, 0, 0, {0}, sl_colormap_names, "", \
      "colormap for the attribute", SL_INVALIDATE_FRAME}, \
     {"scalar_min", SL_PARAM_FLOAT, -1e30, 1e30, {0}, NULL, "", \
-     "attribute value at the colormap's start (min == max: the attribute's range)", SL_INVALIDATE_FRAME}, \
+     "attribute value at the colormap's start (min == max: the attribute's range; min > max inverts the map)", \
+     SL_INVALIDATE_FRAME}, \
     {"scalar_max", SL_PARAM_FLOAT, -1e30, 1e30, {0}, NULL, "", \
      "attribute value at the colormap's end", SL_INVALIDATE_FRAME}, \
     {"color", SL_PARAM_VEC3, 0.0, 1.0, {0.8, 0.8, 0.8}, NULL, "rgb", \

@@ -48,7 +48,7 @@ void main()
         return;
     }
     float span = u_scalar_range.y - u_scalar_range.x;
-    float t = span > 0.0 ? clamp((v_scalar - u_scalar_range.x) / span, 0.0, 1.0) : 0.5;
+    float t = span != 0.0 ? clamp((v_scalar - u_scalar_range.x) / span, 0.0, 1.0) : 0.5; // as sl_colormap
     oit_nodes[index].color = packUnorm4x8(vec4(c, u_opacity_ramp != 0 ? u_opacity * t : u_opacity));
     oit_nodes[index].depth = dot(v_position - sl_eye.xyz, sl_forward.xyz);
     uint prev = imageAtomicExchange(u_heads, px, index);

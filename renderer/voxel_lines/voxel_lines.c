@@ -514,7 +514,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     int ramp = style.attribute >= 0 && sl_params_choice(params, "opacity_transfer") == 1;
     float span = style.scalar_range[1] - style.scalar_range[0];
     float attr_range[2] = {0.5f, 0.5f};
-    if (style.attribute >= 0 && span > 0.0f) {
+    if (style.attribute >= 0 && span != 0.0f) { /* min > max: inverted, as in colormap.glsl */
         const sl_attribute *a = &s->dataset->lines.attributes[style.attribute];
         attr_range[0] = (a->min - style.scalar_range[0]) / span;
         attr_range[1] = (a->max - style.scalar_range[0]) / span;
