@@ -47,6 +47,18 @@ static void random_hex(char *out, int bytes)
 
 /* ---------- outgoing messages ---------- */
 
+/* text (consumed) copied behind the LWS_PRE bytes lws_write needs; NULL when
+ * out of memory. */
+static uint8_t *lws_text_buffer(char *text, size_t *len)
+{
+    *len = strlen(text);
+    uint8_t *buf = malloc(LWS_PRE + *len);
+    if (buf)
+        memcpy(buf + LWS_PRE, text, *len);
+    free(text);
+    return buf;
+}
+
 int sl_client_queue_text(sl_client *c, char *text)
 {
     if (!text)
@@ -58,14 +70,10 @@ int sl_client_queue_text(sl_client *c, char *text)
         lws_set_timeout(c->wsi, PENDING_TIMEOUT_CLOSE_SEND, LWS_TO_KILL_ASYNC);
         return -1;
     }
-    size_t len = strlen(text);
-    uint8_t *buf = malloc(LWS_PRE + len);
-    if (!buf) {
-        free(text);
+    size_t len;
+    uint8_t *buf = lws_text_buffer(text, &len);
+    if (!buf)
         return -1;
-    }
-    memcpy(buf + LWS_PRE, text, len);
-    free(text);
     int slot = (c->text_head + c->text_count) % SL_CLIENT_MAX_TEXT;
     c->text[slot] = buf;
     c->text_len[slot] = len;
@@ -804,14 +812,10 @@ static int write_text_now(sl_client *c, char *text)
 {
     if (!text)
         return -1;
-    size_t len = strlen(text);
-    uint8_t *buf = malloc(LWS_PRE + len);
-    if (!buf) {
-        free(text);
+    size_t len;
+    uint8_t *buf = lws_text_buffer(text, &len);
+    if (!buf)
         return -1;
-    }
-    memcpy(buf + LWS_PRE, text, len);
-    free(text);
     int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
     free(buf);
     lws_callback_on_writable(c->wsi);

@@ -3,7 +3,7 @@
  * Generator JSON arrives from scenes over the network, so its parsing and
  * key validation get the same treatment as a file loader. The input is
  * NUL-terminated and passed as the call; the result is checked by
- * sl_fuzz_check (fuzz_lines_check.h): on failure *out stays NULL with a
+ * sl_fuzz_check (fuzz_check.h): on failure *out stays NULL with a
  * message, on success the dataset is consistent and fully read. Calls whose
  * numeric keys (other than seed and time) exceed 64 are skipped so each run
  * stays small; the validation of large values is covered by test_generate.
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "data/sl_generate.h"
-#include "fuzz_lines_check.h"
+#include "fuzz_check.h"
 
 /* 1 when a parsed call would generate more than a few thousand elements. */
 static int too_big(const char *text)

@@ -1,14 +1,14 @@
 /* fuzz_vtk.c — fuzz target for the legacy VTK loader (sl_load_vtk in renderer/data/load_vtk.c).
  *
  * Feeds arbitrary bytes as an in-memory file with path NULL; the result is
- * checked by sl_fuzz_check (fuzz_lines_check.h): on failure *out stays NULL
+ * checked by sl_fuzz_check (fuzz_check.h): on failure *out stays NULL
  * with a message, on success the dataset is consistent and fully read.
  * Seed corpus: tests/fuzz/corpus/vtk/. Single-threaded.
  */
 #include <stdint.h>
 
 #include "data/sl_load.h"
-#include "fuzz_lines_check.h"
+#include "fuzz_check.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

@@ -1,15 +1,18 @@
-/* fuzz_lines_check.h — the result check shared by the line-set fuzz targets
- * (fuzz_trk.c, fuzz_tck.c, fuzz_vtk.c, fuzz_obj.c).
+/* fuzz_check.h — the result check shared by the loader fuzz targets (line
+ * sets: fuzz_trk.c, fuzz_tck.c, fuzz_vtk.c, fuzz_obj.c, fuzz_generate.c;
+ * volumes: fuzz_nrrd.c, fuzz_nifti.c, fuzz_raw_json.c).
  *
  * On failure *out must be NULL and the message non-empty. On success the
  * dataset must be consistent: offsets start at 0, never decrease and end at
  * vertex_count; positions and bounds are finite; every position, normal and
  * attribute value is read (so ASan sees the whole arrays); attribute ranges
- * are ordered. Volumes get the same checks as fuzz_nrrd.c. Violations abort().
- * Single-threaded; test-only.
+ * are ordered. A volume has dims >= 1 within SL_MAX_VOXELS, 1 or 3
+ * components, an ordered value range, positive spacing, and every voxel is
+ * read. Violations abort(); the dataset is destroyed. Single-threaded;
+ * test-only.
  */
-#ifndef SL_FUZZ_LINES_CHECK_H
-#define SL_FUZZ_LINES_CHECK_H
+#ifndef SL_FUZZ_CHECK_H
+#define SL_FUZZ_CHECK_H
 
 #include <math.h>
 #include <stdint.h>
