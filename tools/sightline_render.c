@@ -180,13 +180,17 @@ static int check_output(const char *option, const char *path, const char *const 
         fprintf(stderr, "sightline-render: %s %s: folder %s does not exist\n", option, path, dir);
         return 0;
     }
-    int fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0666);
+    /* A probe file of a unique name in that folder (never the output's
+     * own name: another run may be creating it at the same time). */
+    char probe[4096 + 32];
+    snprintf(probe, sizeof probe, "%s/.sightline-render-XXXXXX", dir);
+    int fd = mkstemp(probe);
     if (fd < 0) {
-        fprintf(stderr, "sightline-render: %s %s: cannot create it in %s: %s\n", option, path, dir, strerror(errno));
+        fprintf(stderr, "sightline-render: %s %s: cannot create files in %s: %s\n", option, path, dir, strerror(errno));
         return 0;
     }
     close(fd);
-    unlink(path);
+    unlink(probe);
     return 1;
 }
 

@@ -76,7 +76,7 @@ foreach(case
     "out_extension|--out ${GPU_OUT}/x.bmp|--out [^\n]*x\\.bmp: unknown extension \\(expected \\.png, \\.jpg, \\.jpeg\\)"
     "out_is_folder|--out ${GPU_OUT}/folder.png|--out [^\n]*folder\\.png: is a folder"
     "depth_extension|--out ${GPU_OUT}/x.png --depth ${GPU_OUT}/x.png|--depth [^\n]*x\\.png: unknown extension \\(expected \\.pfm\\)"
-    "stats_unwritable|--out ${GPU_OUT}/x.png --stats /proc/sightline_stats.json|--stats /proc/sightline_stats\\.json: cannot create it in /proc"
+    "stats_unwritable|--out ${GPU_OUT}/x.png --stats /proc/sightline_stats.json|--stats /proc/sightline_stats\\.json: cannot create files in /proc"
     "stats_extension|--out ${GPU_OUT}/x.png --stats ${GPU_OUT}/stats.txt|--stats [^\n]*stats\\.txt: unknown extension \\(expected \\.json\\)")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)

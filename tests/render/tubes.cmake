@@ -23,7 +23,8 @@ add_executable(test_tubes_reference ${TUBES_DIR}/test_tubes_reference.c ${TUBES_
 target_include_directories(test_tubes_reference PRIVATE ${TUBES_DIR} ${CMAKE_SOURCE_DIR}/tests/unit)
 target_link_libraries(test_tubes_reference PRIVATE sightline_proto sightline_renderer)
 set_target_properties(test_tubes_reference PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-add_test(NAME unit.test_tubes_reference COMMAND test_tubes_reference WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME unit.test_tubes_reference COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_tubes_reference>
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(unit.test_tubes_reference PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
 
 function(tubes_render_test name)
