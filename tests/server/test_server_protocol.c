@@ -248,6 +248,25 @@ static int http_status_with_host(int port, const char *host)
     return len >= 12 ? atoi(out + 9) : 0;
 }
 
+/* Waits for a still frame of camera_seq >= seq; counts the error messages
+ * received meanwhile into *errors. 1 when the frame came. */
+static int wait_still_counting_errors(tclient *c, uint32_t seq, int *errors)
+{
+    double deadline = harness_now_ms() + T;
+    while (harness_now_ms() < deadline) {
+        cJSON *j = NULL;
+        int rr = tclient_next(c, T, &j);
+        if (rr == 1 && strcmp(json_type(j), "error") == 0)
+            (*errors)++;
+        cJSON_Delete(j);
+        if (rr == 2 && c->last.h.camera_seq >= seq && !(c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE))
+            return 1;
+        if (rr == 0)
+            return 0;
+    }
+    return 0;
+}
+
 static double metric(const char *text, const char *name)
 {
     char key[128];
@@ -417,19 +436,8 @@ int main(void)
         SL_CHECK_MSG(v0 > 0 && v1 == v0 + 1, "state version %u -> %u across refused cameras", v0, v1);
         SL_CHECK(seq && seq->valueint == 70);
         cJSON_Delete(m);
-        int got = 0, render_failed = 0;
-        double deadline = harness_now_ms() + T;
-        while (!got && harness_now_ms() < deadline) {
-            cJSON *j = NULL;
-            int rr = tclient_next(&a, T, &j);
-            if (rr == 1 && strcmp(json_type(j), "error") == 0)
-                render_failed++;
-            cJSON_Delete(j);
-            if (rr == 2 && a.last.h.camera_seq == 70 && !(a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE))
-                got = 1;
-            if (rr == 0)
-                break;
-        }
+        int render_failed = 0;
+        int got = wait_still_counting_errors(&a, 70, &render_failed);
         SL_CHECK_MSG(got && render_failed == 0, "frame for seq 70: %d, errors meanwhile: %d", got, render_failed);
     }
 
@@ -898,18 +906,8 @@ int main(void)
     late.auto_ack = 1;
     SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":80,\"camera\":{\"orbit\":{\"azimuth\":33,\"elevation\":3,\"distance\":2}}}") == 0);
     {
-        int got = 0, errors = 0;
-        double deadline = harness_now_ms() + T;
-        while (!got && harness_now_ms() < deadline) {
-            cJSON *j = NULL;
-            int rr = tclient_next(&late, T, &j);
-            if (rr == 1 && strcmp(json_type(j), "error") == 0)
-                errors++;
-            cJSON_Delete(j);
-            got = rr == 2 && late.last.h.camera_seq >= 80 && !(late.last.h.flags & SL_FRAME_FLAG_INTERACTIVE);
-            if (rr == 0)
-                break;
-        }
+        int errors = 0;
+        int got = wait_still_counting_errors(&late, 80, &errors);
         SL_CHECK_MSG(got && errors == 0, "late joiner: frame %d, stale errors %d", got, errors);
     }
 
