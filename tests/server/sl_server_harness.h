@@ -14,14 +14,17 @@
 #ifndef SL_SERVER_HARNESS_H
 #define SL_SERVER_HARNESS_H
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -385,6 +388,46 @@ static __attribute__((unused)) int tclient_wait_frame(tclient *c, uint32_t seq, 
             return -1;
     }
     return -1;
+}
+
+/* GET path from 127.0.0.1:port with the given Host header (NULL:
+ * "127.0.0.1:port"); the response (headers and body, NUL-terminated,
+ * truncated to out_size - 1) goes to out. Returns the HTTP status, or -1
+ * when the connection or the request failed (5 s timeout). */
+static __attribute__((unused)) int harness_http_get(int port, const char *host, const char *path, char *out,
+                                                    size_t out_size)
+{
+    out[0] = 0;
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    char req[512], local[64];
+    snprintf(local, sizeof local, "127.0.0.1:%d", port);
+    int n = snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n\r\n", path,
+                     host ? host : local);
+    if (n <= 0 || (size_t)n >= sizeof req || write(fd, req, (size_t)n) != n) {
+        close(fd);
+        return -1;
+    }
+    size_t len = 0;
+    double deadline = harness_now_ms() + 5000;
+    while (len + 1 < out_size && harness_now_ms() < deadline) {
+        struct pollfd pfd = {.fd = fd, .events = POLLIN};
+        if (poll(&pfd, 1, 200) <= 0)
+            continue;
+        ssize_t r = read(fd, out + len, out_size - 1 - len);
+        if (r <= 0)
+            break;
+        len += (size_t)r;
+    }
+    out[len] = 0;
+    close(fd);
+    return len >= 12 ? atoi(out + 9) : -1; /* "HTTP/1.1 200" */
 }
 
 /* hello (new session when session is NULL); fills session/token/client_id. Returns 0 on welcome. */

@@ -202,37 +202,9 @@ static long rss_kib(pid_t pid)
 static double healthz_ms(int port)
 {
     double t0 = harness_now_ms();
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
-        if (fd >= 0)
-            close(fd);
-        return 1e9;
-    }
-    char req[128];
-    snprintf(req, sizeof req, "GET /healthz HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n", port);
     char buf[1024];
-    size_t len = 0;
-    if (write(fd, req, strlen(req)) < 0) {
-        close(fd);
-        return 1e9;
-    }
-    while (harness_now_ms() - t0 < 10000 && len + 1 < sizeof buf) {
-        struct pollfd pfd = {.fd = fd, .events = POLLIN};
-        if (poll(&pfd, 1, 100) <= 0)
-            continue;
-        ssize_t r = read(fd, buf + len, sizeof buf - 1 - len);
-        if (r <= 0)
-            break;
-        len += (size_t)r;
-        buf[len] = 0;
-        if (strstr(buf, "\"status\":\"ok\""))
-            break;
-    }
-    close(fd);
-    buf[len] = 0;
-    return strstr(buf, "\"status\":\"ok\"") ? harness_now_ms() - t0 : 1e9;
+    int status = harness_http_get(port, NULL, "/healthz", buf, sizeof buf);
+    return status == 200 && strstr(buf, "\"status\":\"ok\"") ? harness_now_ms() - t0 : 1e9;
 }
 
 int main(void)

@@ -91,34 +91,7 @@ static int still_usable(tclient *c, int seq)
 
 static int http_get(int port, const char *path, char *out, size_t out_size)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
-        if (fd >= 0)
-            close(fd);
-        return -1;
-    }
-    char req[256];
-    int n = snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n", path, port);
-    if (write(fd, req, (size_t)n) != n) {
-        close(fd);
-        return -1;
-    }
-    size_t len = 0;
-    double deadline = harness_now_ms() + 5000;
-    while (len + 1 < out_size && harness_now_ms() < deadline) {
-        struct pollfd pfd = {.fd = fd, .events = POLLIN};
-        if (poll(&pfd, 1, 200) <= 0)
-            continue;
-        ssize_t r = read(fd, out + len, out_size - 1 - len);
-        if (r <= 0)
-            break;
-        len += (size_t)r;
-    }
-    out[len] = 0;
-    close(fd);
-    return atoi(out + 9); /* "HTTP/1.1 200" */
+    return harness_http_get(port, NULL, path, out, out_size);
 }
 
 /* Waits for a state patch whose `key` is the string `value`; returns its version (0 on timeout). */
@@ -220,32 +193,8 @@ static int upgrade_with(int port, const char *host, const char *origin)
 /* GET / with an explicit Host header; returns the HTTP status. */
 static int http_status_with_host(int port, const char *host)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
-        if (fd >= 0)
-            close(fd);
-        return -1;
-    }
-    char req[256], out[512] = "";
-    int n = snprintf(req, sizeof req, "GET / HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n\r\n", host);
-    size_t len = 0;
-    if (write(fd, req, (size_t)n) == n) {
-        double deadline = harness_now_ms() + 5000;
-        while (len < 12 && harness_now_ms() < deadline) {
-            struct pollfd pfd = {.fd = fd, .events = POLLIN};
-            if (poll(&pfd, 1, 200) <= 0)
-                continue;
-            ssize_t r = read(fd, out + len, sizeof out - 1 - len);
-            if (r <= 0)
-                break;
-            len += (size_t)r;
-        }
-    }
-    close(fd);
-    out[len] = 0;
-    return len >= 12 ? atoi(out + 9) : 0;
+    char out[512];
+    return harness_http_get(port, host, "/", out, sizeof out);
 }
 
 /* Waits for a still frame of camera_seq >= seq; counts the error messages
