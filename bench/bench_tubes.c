@@ -1,44 +1,37 @@
 /* bench_tubes.c — the experiment of Russig et al. (4, Fig. 5) for `tubes`, plus accuracy tables.
  *
- *   bench-tubes [--size WxH] [--frames N] [--datasets fibers,hotroom,bundle,brain,furball]
- *               [--skip-perf] [--skip-error] [--skip-cubic] [--skip-vtk] [--vtk-png PREFIX]
+ *   bench-tubes [--small | --size WxH] [--frames N] [--datasets fibers,hotroom,bundle,brain,furball]
+ *               [--skip-perf] [--skip-error] [--skip-cubic] [--skip-peers]
  *
  * 1. Speed: generated stand-ins for the paper's five datasets (about 3.5k,
  *    31k, 106k, 114k, 787k segments) in a far view (the bounding sphere fits
  *    the 45 degree view) and a close view (1/3 of that distance), an orbit of
- *    N frames each: median frame ms of tubes, tubes with the empty fragment
- *    shader (silhouette_only), tubes_mesh; ratio; triangles; GPU memory.
- *    Then the same lines through what users would otherwise pick, VTK's tube
- *    filter (bench/vtk_tubes.py: same radius, tubes_mesh's default sides and
- *    caps, same image size, cameras and orbit), run as
- *    `xvfb-run -a /usr/bin/python3 SOURCE/bench/vtk_tubes.py` on a temporary
- *    legacy-VTK copy of the lines (Debian's VTK is X11-only; scripts/bench
- *    installs bench/packages.txt): its median frame ms (wall, render +
- *    glFinish), tube filter ms, and our ratio to it. When VTK or xvfb-run is
- *    missing the table says "VTK: not available (reason)". SOURCE is
- *    $SIGHTLINE_SOURCE_DIR, else the source tree this was built from.
+ *    N frames each, timed by the harness (bench/harness/sl_bench.h: wall ms to
+ *    glFinish after the readback, GPU ms as a second column): tubes (with its
+ *    occlusion pre-pass, the default), tubes in one pass (the paper's), the
+ *    empty fragment shader (silhouette_only), tubes_mesh; triangles; GPU memory.
+ *    Then the same lines and cameras through the peers: VTK's tube filter and
+ *    Embree round curves (sl_bench_peer_*), as ratios to ours.
  * 2. Error against time: every root method x iterations 2..12, 16, 20, 24, 32,
- *    depth error against the CPU reference (tests/render/tubes/tubes_reference.c) and ms.
+ *    depth error against the CPU reference (tests/render/tubes/tubes_reference.c)
+ *    at 128x128, and the frame ms of the same scene at the benchmark size.
  * 3. How far the quadratic pair lies from the true cubic Hermite sweep
  *    (both by the reference) on smaller versions of the five datasets.
- * Defaults (160x90, 3 frames) take a few minutes on llvmpipe; --size
- * 1920x1080 --frames 1000 is the paper's setting. --skip-vtk leaves VTK
- * out; --vtk-png PREFIX keeps VTK's first orbit frame of each dataset and view
- * as PREFIX-DATASET-VIEW.png. Prints Markdown; checks nothing. Render thread = main.
+ * Defaults: 1280x720, 3 frames; --small for a quick look. Prints Markdown;
+ * checks nothing. Render thread = main.
  */
-#include <cjson/cJSON.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "line_style/sl_line_style.h"
 #include "core/sl_technique.h"
 #include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"
+#include "harness/sl_bench.h"
 #include "pipeline/sl_pipeline.h"
 #include "tubes/tubes_nodes.h"
 
@@ -67,36 +60,13 @@ static const bench_dataset datasets[] = {
 #define DATASET_COUNT ((int)(sizeof datasets / sizeof datasets[0]))
 
 typedef struct options {
-    int width, height, frames, skip_perf, skip_error, skip_cubic, skip_vtk;
+    sl_bench_options bench;
+    int skip_perf, skip_error, skip_cubic, skip_peers;
     const char *only;
-    const char *vtk_png; /* prefix of VTK's saved frames, or NULL */
 } options;
 
-#ifndef SIGHTLINE_SOURCE_DIR
-#define SIGHTLINE_SOURCE_DIR "."
-#endif
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : 0.0;
-}
-
-static size_t segment_count(const sl_dataset *ds)
-{
-    size_t n = 0;
-    for (size_t k = 0; k < ds->lines.line_count; k++) {
-        size_t len = ds->lines.line_offsets[k + 1] - ds->lines.line_offsets[k];
-        n += len >= 2 ? len - 1 : 0;
-    }
-    return n;
-}
+static double median(double *v, int n) { return sl_bench_median(v, n); }
+static size_t segment_count(const sl_dataset *ds) { return sl_bench_segment_count(ds); }
 
 static sl_status make_view(const sl_dataset *ds, double azimuth, double distance, int w, int h, sl_view *view,
                            sl_err *err)
@@ -111,277 +81,14 @@ static sl_status make_view(const sl_dataset *ds, double azimuth, double distance
     return st == SL_OK ? sl_view_init(view, sl_dataset_radius(ds), err) : st;
 }
 
-typedef struct run_result { double ms, wall_ms, prepare_ms, primitives; size_t bytes; } run_result;
+#define VIEWS 2
 
-/* Median frame ms over an orbit of `frames` frames (the first frame, which
- * prepares, is rendered once before timing). */
-static sl_status run_orbit(sl_pipeline *p, const sl_technique *t, const sl_params *params, double distance,
-                           const options *o, run_result *out, sl_err *err)
+static void print_peer_cell(const sl_bench_peer_result *r, int v, double ours_ms)
 {
-    sl_status st = sl_pipeline_set_technique(p, t, params, err);
-    if (st != SL_OK)
-        return st;
-    const sl_dataset *ds = sl_pipeline_dataset(p);
-    double *ms = calloc(2 * (size_t)o->frames, sizeof *ms), *wall = ms + o->frames;
-    if (!ms)
-        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
-    sl_view view;
-    sl_frame_stats stats = {0};
-    if ((st = make_view(ds, 0.0, distance, o->width, o->height, &view, err)) == SL_OK)
-        st = sl_pipeline_render(p, &view, 1, &stats, err);
-    out->prepare_ms = stats.prepare_ms;
-    for (int f = 0; st == SL_OK && f < o->frames; f++) {
-        if ((st = make_view(ds, 360.0 * f / o->frames, distance, o->width, o->height, &view, err)) != SL_OK ||
-            (st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
-            break;
-        ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
-        wall[f] = stats.wall_ms;
-    }
-    out->ms = median(ms, o->frames);
-    out->wall_ms = median(wall, o->frames);
-    out->primitives = stats.render.primitives;
-    out->bytes = stats.gpu_bytes;
-    free(ms);
-    return st;
-}
-
-/* ---- VTK's tube filter, the baseline users would otherwise pick (bench/vtk_tubes.py) ---- */
-
-#define VTK_VIEWS 2
-
-typedef struct vtk_result {
-    int ok;
-    char reason[240];         /* when !ok */
-    double filter_ms, first_frame_ms, triangles, seconds;
-    double ms[VTK_VIEWS];     /* median frame ms per view */
-    char gl[128], version[32];
-} vtk_result;
-
-static void put_be32(uint32_t v, FILE *f)
-{
-    unsigned char b[4] = {(unsigned char)(v >> 24), (unsigned char)(v >> 16), (unsigned char)(v >> 8), (unsigned char)v};
-    fwrite(b, 1, 4, f);
-}
-
-static void put_be_float(float x, FILE *f)
-{
-    uint32_t v;
-    memcpy(&v, &x, sizeof v);
-    put_be32(v, f);
-}
-
-/* The lines as legacy VTK POLYDATA (binary, big-endian), in the dataset's
- * float coordinates (world - origin); data radii (x radius_scale) as point scalars. */
-static int write_vtk_lines(const sl_dataset *ds, float radius_scale, const char *path)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return -1;
-    const sl_lines *l = &ds->lines;
-    fprintf(f, "# vtk DataFile Version 3.0\nsightline bench-tubes %s\nBINARY\nDATASET POLYDATA\nPOINTS %zu float\n",
-            ds->name, l->vertex_count);
-    for (size_t k = 0; k < 3 * l->vertex_count; k++)
-        put_be_float(l->positions[k], f);
-    fprintf(f, "\nLINES %zu %zu\n", l->line_count, l->line_count + l->vertex_count);
-    for (size_t k = 0; k < l->line_count; k++) {
-        put_be32(l->line_offsets[k + 1] - l->line_offsets[k], f);
-        for (uint32_t i = l->line_offsets[k]; i < l->line_offsets[k + 1]; i++)
-            put_be32(i, f);
-    }
-    if (l->radii) {
-        fprintf(f, "\nPOINT_DATA %zu\nSCALARS radius float 1\nLOOKUP_TABLE default\n", l->vertex_count);
-        for (size_t k = 0; k < l->vertex_count; k++)
-            put_be_float(l->radii[k] * radius_scale, f);
-    }
-    fputc('\n', f);
-    int bad = ferror(f);
-    return fclose(f) == 0 && !bad ? 0 : -1;
-}
-
-/* One line a frame: VIEW INDEX eye target up fov (relative to the dataset origin);
- * INDEX -1 is the untimed first frame run_orbit also renders. */
-static sl_status write_vtk_cameras(const sl_dataset *ds, const double *dists, const char *const *names,
-                                   const options *o, const char *path, sl_err *err)
-{
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return sl_err_set(err, SL_ERR_IO, "cannot write %s", path);
-    sl_status st = SL_OK;
-    for (int v = 0; v < VTK_VIEWS && st == SL_OK; v++)
-        for (int fr = -1; fr < o->frames && st == SL_OK; fr++) {
-            sl_view view;
-            if ((st = make_view(ds, fr < 0 ? 0.0 : 360.0 * fr / o->frames, dists[v], o->width, o->height, &view,
-                                err)) != SL_OK)
-                break;
-            const sl_camera *c = &view.camera;
-            fprintf(f, "%s %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", names[v], fr,
-                    c->eye.x - ds->origin.x, c->eye.y - ds->origin.y, c->eye.z - ds->origin.z,
-                    c->target.x - ds->origin.x, c->target.y - ds->origin.y, c->target.z - ds->origin.z, c->up.x,
-                    c->up.y, c->up.z, c->fov_y_deg);
-        }
-    if (fclose(f) != 0 && st == SL_OK)
-        st = sl_err_set(err, SL_ERR_IO, "cannot write %s", path);
-    return st;
-}
-
-static int executable_on_path(const char *name)
-{
-    const char *path = getenv("PATH");
-    if (!path || !*path)
-        path = "/usr/local/bin:/usr/bin:/bin";
-    while (*path) {
-        size_t n = strcspn(path, ":");
-        char full[4096];
-        if (n > 0 && n + strlen(name) + 2 < sizeof full) {
-            snprintf(full, sizeof full, "%.*s/%s", (int)n, path, name);
-            if (access(full, X_OK) == 0)
-                return 1;
-        }
-        path += n + (path[n] == ':');
-    }
-    return 0;
-}
-
-/* Appends s to the shell command in single quotes. */
-static void append_quoted(char *cmd, size_t size, const char *s)
-{
-    size_t n = strlen(cmd);
-    if (n + 1 < size)
-        cmd[n++] = '\'';
-    for (; *s && n + 5 < size; s++) {
-        if (*s == '\'') {
-            memcpy(cmd + n, "'\\''", 4);
-            n += 4;
-        } else
-            cmd[n++] = *s;
-    }
-    if (n + 1 < size)
-        cmd[n++] = '\'';
-    cmd[n] = 0;
-}
-
-static void set_reason(vtk_result *r, const char *what)
-{
-    r->ok = 0;
-    size_t n = 0;
-    for (const char *c = what; *c && n + 1 < sizeof r->reason; c++)
-        r->reason[n++] = (*c == '|' || *c == '\n' || *c == '\r') ? ' ' : *c;
-    r->reason[n] = 0;
-}
-
-/* Why VTK cannot run here (written to reason), or 0 when it may. */
-static int vtk_missing(const char *script, char *reason, size_t size)
-{
-    if (access(script, R_OK) != 0)
-        snprintf(reason, size, "no %.400s; set SIGHTLINE_SOURCE_DIR", script);
-    else if (access("/usr/bin/python3", X_OK) != 0)
-        snprintf(reason, size, "no /usr/bin/python3");
-    else if (!executable_on_path("xvfb-run"))
-        snprintf(reason, size, "no xvfb-run on PATH; scripts/bench installs bench/packages.txt");
+    if (r->ok && ours_ms > 0.0)
+        printf(" %.1f (%.2f) |", r->median_ms[v], r->median_ms[v] / ours_ms);
     else
-        return 0;
-    return 1;
-}
-
-static double json_number(const cJSON *o, const char *key)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-    return cJSON_IsNumber(v) ? v->valuedouble : 0.0;
-}
-
-/* Runs bench/vtk_tubes.py on ds for both views; fills r (r->ok = 0 with a reason on any failure). */
-static void run_vtk(const sl_dataset *ds, const char *dataset_name, const double *dists, const char *const *names,
-                    const options *o, vtk_result *r)
-{
-    memset(r, 0, sizeof *r);
-    const char *src = getenv("SIGHTLINE_SOURCE_DIR");
-    char script[4096], reason[512];
-    snprintf(script, sizeof script, "%s/bench/vtk_tubes.py", src && *src ? src : SIGHTLINE_SOURCE_DIR);
-    if (vtk_missing(script, reason, sizeof reason)) {
-        set_reason(r, reason);
-        return;
-    }
-    const sl_technique *mesh = sl_technique_find("tubes_mesh");
-    sl_params mp;
-    sl_params_init(&mp, mesh->params, mesh->param_count);
-    sl_line_style style;
-    sl_line_style_read(&mp, ds, &style);
-    char dir[] = "/tmp/sightline-vtk-XXXXXX", lines[64], cams[64];
-    if (!mkdtemp(dir)) {
-        set_reason(r, "cannot create a temporary directory");
-        return;
-    }
-    snprintf(lines, sizeof lines, "%s/lines.vtk", dir);
-    snprintf(cams, sizeof cams, "%s/cameras.txt", dir);
-    sl_err err = {0};
-    if (write_vtk_lines(ds, style.radius_scale, lines) != 0) {
-        set_reason(r, "cannot write the lines file");
-        goto done;
-    }
-    if (write_vtk_cameras(ds, dists, names, o, cams, &err) != SL_OK) {
-        set_reason(r, err.message);
-        goto done;
-    }
-    char cmd[16384];
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 %dx%dx24' /usr/bin/python3 ",
-             o->width > 1280 ? o->width : 1280, o->height > 1024 ? o->height : 1024);
-    append_quoted(cmd, sizeof cmd, script);
-    size_t n = strlen(cmd);
-    snprintf(cmd + n, sizeof cmd - n, " --lines %s --cameras %s --size %dx%d --radius %.9g --sides %d --caps %d",
-             lines, cams, o->width, o->height, (double)style.radius, sl_params_int(&mp, "sides"),
-             sl_params_bool(&mp, "caps") ? 1 : 0);
-    if (o->vtk_png) {
-        char prefix[4096];
-        snprintf(prefix, sizeof prefix, "%s-%s", o->vtk_png, dataset_name);
-        strncat(cmd, " --png ", sizeof cmd - strlen(cmd) - 1);
-        append_quoted(cmd, sizeof cmd, prefix);
-    }
-    strncat(cmd, " 2>&1", sizeof cmd - strlen(cmd) - 1);
-    fflush(stdout);
-    double t0 = sl_now_ms();
-    FILE *p = popen(cmd, "r");
-    if (!p) {
-        set_reason(r, "cannot start xvfb-run");
-        goto done;
-    }
-    char line[8192], json[8192] = "", last[512] = "";
-    while (fgets(line, sizeof line, p)) {
-        line[strcspn(line, "\r\n")] = 0;
-        if (line[0] == '{')
-            snprintf(json, sizeof json, "%s", line);
-        else if (line[0])
-            snprintf(last, sizeof last, "%.500s", line);
-    }
-    int status = pclose(p);
-    r->seconds = (sl_now_ms() - t0) / 1000.0;
-    cJSON *root = json[0] ? cJSON_Parse(json) : NULL;
-    if (!root) {
-        snprintf(reason, sizeof reason, "xvfb-run exited with status %d%s%.400s",
-                 status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1, last[0] ? ": " : "", last);
-        set_reason(r, reason);
-        goto done;
-    }
-    const cJSON *views = cJSON_GetObjectItemCaseSensitive(root, "views");
-    const cJSON *error = cJSON_GetObjectItemCaseSensitive(root, "error");
-    if (!cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(root, "ok")) || !cJSON_IsObject(views)) {
-        set_reason(r, cJSON_IsString(error) ? error->valuestring : "bench/vtk_tubes.py failed");
-    } else {
-        r->ok = 1;
-        r->filter_ms = json_number(root, "filter_ms");
-        r->first_frame_ms = json_number(root, "first_frame_ms");
-        r->triangles = json_number(root, "triangles");
-        const cJSON *gl = cJSON_GetObjectItemCaseSensitive(root, "gl_renderer");
-        const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "vtk");
-        snprintf(r->gl, sizeof r->gl, "%s", cJSON_IsString(gl) ? gl->valuestring : "unknown");
-        snprintf(r->version, sizeof r->version, "%s", cJSON_IsString(version) ? version->valuestring : "?");
-        for (int v = 0; v < VTK_VIEWS; v++)
-            r->ms[v] = json_number(cJSON_GetObjectItemCaseSensitive(views, names[v]), "median_ms");
-    }
-    cJSON_Delete(root);
-done:
-    remove(lines);
-    remove(cams);
-    rmdir(dir);
+        printf(" n/a |");
 }
 
 static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
@@ -389,14 +96,22 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
     const sl_technique *tubes = sl_technique_find("tubes"), *mesh = sl_technique_find("tubes_mesh");
     if (!tubes || !mesh)
         return sl_err_set(err, SL_ERR_UNSUPPORTED, "tubes or tubes_mesh is not registered");
-    printf("\n## Speed (%dx%d, median of %d orbit frames, ms)\n\n", o->width, o->height, o->frames);
-    printf("| dataset | segments | view | tubes | silhouette only | tubes_mesh | mesh / tubes | tubes triangles | mesh triangles | tubes MB | mesh MB |\n");
-    printf("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    /* Kept for the VTK table, printed after this one. */
-    struct { int done; run_result tubes[VTK_VIEWS], mesh[VTK_VIEWS]; vtk_result vtk; } rows[DATASET_COUNT];
-    memset(rows, 0, sizeof rows);
-    char vtk_unavailable[240] = "";
-    const char *names[VTK_VIEWS] = {"far", "close"};
+    const sl_bench_options *bo = &o->bench;
+    sl_params mp0;
+    sl_params_init(&mp0, mesh->params, mesh->param_count);
+    printf("\n## Speed (%dx%d, %d orbit frames after a warm-up; wall ms to glFinish after the readback)\n\n"
+           "tubes: with its occlusion pre-pass (the default); one pass: occlusion_prepass off, the paper's; silhouette "
+           "only: boxes with a fragment shader that discards (vertex, geometry and raster cost). Peers read the same "
+           "lines (legacy VTK) and cameras: VTK (Debian python3-vtk9): vtkTubeFilter (%d sides, %s, as tubes_mesh) + vtkPolyDataMapper on "
+           "the same GL under xvfb-run; Embree round Hermite curves on the CPU, one thread per core. In brackets: peer "
+           "ms / tubes ms (above 1: tubes is faster).\n\n",
+           bo->width, bo->height, bo->frames, sl_params_int(&mp0, "sides"),
+           sl_params_bool(&mp0, "caps") ? "capped" : "open");
+    printf("| dataset | segments | view | tubes median (min-max) | GPU ms | one pass | silhouette only | tubes_mesh | "
+           "mesh / tubes | VTK (VTK / tubes) | Embree (Embree / tubes) | tubes triangles | tubes MB | mesh MB | "
+           "peak RSS MB |\n");
+    printf("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    const char *names[VIEWS] = {"far", "close"};
     for (int d = 0; d < DATASET_COUNT; d++) {
         if (o->only && !strstr(o->only, datasets[d].name))
             continue;
@@ -412,85 +127,65 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
         }
         sl_pipeline_set_dataset(p, ds);
         const double far = 1.0 / sin(22.5 * SL_PI / 180.0); /* bounding sphere fits the 45 degree view */
-        const double dists[VTK_VIEWS] = {far, far / 3.0};
-        for (int v = 0; v < VTK_VIEWS && st == SL_OK; v++) {
-            sl_params tp, sp, mp;
+        const sl_bench_orbit orbits[VIEWS] = {{far, 20.0, 45.0}, {far / 3.0, 20.0, 45.0}};
+        const sl_bench_view_spec views[VIEWS] = {{names[0], sl_bench_orbit_camera, &orbits[0]},
+                                                 {names[1], sl_bench_orbit_camera, &orbits[1]}};
+        sl_bench_peer_result vtk = {0}, embree = {0};
+        if (!o->skip_peers) {
+            sl_line_style style;
+            sl_line_style_read(&mp0, ds, &style);
+            sl_bench_peer_files files;
+            if ((st = sl_bench_peer_files_write(ds, style.radius_scale, views, VIEWS, bo, &files, err)) != SL_OK) {
+                sl_pipeline_destroy(p);
+                return st;
+            }
+            long cores = sysconf(_SC_NPROCESSORS_ONLN);
+            sl_bench_tube_peer_desc pd = {.files = &files, .views = views, .view_count = VIEWS, .options = bo,
+                                          .radius = style.radius, .sides = sl_params_int(&mp0, "sides"),
+                                          .caps = sl_params_bool(&mp0, "caps"), .threads = cores > 0 ? (int)cores : 1};
+            sl_bench_peer_vtk_tubes(&pd, &vtk);
+            sl_bench_peer_embree_tubes(&pd, &embree);
+            sl_bench_peer_files_remove(&files);
+            if (!vtk.ok)
+                fprintf(stderr, "bench-tubes: VTK: %s\n", vtk.reason);
+            if (!embree.ok)
+                fprintf(stderr, "bench-tubes: Embree: %s\n", embree.reason);
+        }
+        for (int v = 0; v < VIEWS && st == SL_OK; v++) {
+            sl_params tp, op, sp, mp;
             sl_params_init(&tp, tubes->params, tubes->param_count);
+            sl_params_init(&op, tubes->params, tubes->param_count);
             sl_params_init(&sp, tubes->params, tubes->param_count);
             sl_params_init(&mp, mesh->params, mesh->param_count);
-            double one = 1.0;
-            sl_params_set_numbers(&sp, "silhouette_only", &one, 1, err);
-            run_result rt = {0}, rs = {0}, rm = {0};
-            if ((st = run_orbit(p, tubes, &tp, dists[v], o, &rt, err)) != SL_OK ||
-                (st = run_orbit(p, tubes, &sp, dists[v], o, &rs, err)) != SL_OK ||
-                (st = run_orbit(p, mesh, &mp, dists[v], o, &rm, err)) != SL_OK)
+            sl_bench_set(&op, "occlusion_prepass", 0, err);
+            sl_bench_set(&sp, "silhouette_only", 1, err);
+            sl_bench_timing rt, ro, rs, rm;
+            if ((st = sl_bench_time_frames(p, tubes, &tp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rt,
+                                           err)) != SL_OK ||
+                (st = sl_bench_time_frames(p, tubes, &op, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &ro,
+                                           err)) != SL_OK ||
+                (st = sl_bench_time_frames(p, tubes, &sp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rs,
+                                           err)) != SL_OK ||
+                (st = sl_bench_time_frames(p, mesh, &mp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rm,
+                                           err)) != SL_OK)
                 break;
-            printf("| %s | %zu | %s | %.1f | %.1f | %.1f | %.2f | %.0f | %.0f | %.1f | %.1f |\n", datasets[d].name, segs,
-                   names[v], rt.ms, rs.ms, rm.ms, rt.ms > 0 ? rm.ms / rt.ms : 0.0, rt.primitives, rm.primitives,
-                   rt.bytes / 1048576.0, rm.bytes / 1048576.0);
+            char gpu_cell[32];
+            printf("| %s | %zu | %s | %.1f (%.1f-%.1f) | %s | %.1f | %.1f | %.1f | %.2f |", datasets[d].name, segs,
+                   names[v], rt.median_ms, rt.min_ms, rt.max_ms, sl_bench_gpu_cell(&rt, gpu_cell, sizeof gpu_cell),
+                   ro.median_ms, rs.median_ms, rm.median_ms, rt.median_ms > 0 ? rm.median_ms / rt.median_ms : 0.0);
+            print_peer_cell(&vtk, v, rt.median_ms);
+            print_peer_cell(&embree, v, rt.median_ms);
+            printf(" %.0f | %.1f | %.1f | %.0f |\n", rt.primitives, rt.gpu_bytes / 1048576.0, rm.gpu_bytes / 1048576.0,
+                   fmax(rt.peak_rss_mb, rm.peak_rss_mb));
             fflush(stdout);
-            rows[d].tubes[v] = rt;
-            rows[d].mesh[v] = rm;
         }
-        if (st == SL_OK && !o->skip_vtk && !vtk_unavailable[0]) {
-            run_vtk(ds, datasets[d].name, dists, names, o, &rows[d].vtk);
-            /* Missing tools stay missing: do not try again for every dataset. */
-            if (!rows[d].vtk.ok && strncmp(rows[d].vtk.reason, "no ", 3) == 0)
-                snprintf(vtk_unavailable, sizeof vtk_unavailable, "%s", rows[d].vtk.reason);
-        }
-        rows[d].done = st == SL_OK;
         sl_pipeline_destroy(p);
         if (st != SL_OK)
             return st;
     }
-    printf("\n(tubes triangles: box faces emitted by the geometry shader, 2 per face, after culling.)\n");
-    if (o->skip_vtk) {
-        printf("\nVTK tube filter comparison: skipped (--skip-vtk).\n");
-        return SL_OK;
-    }
-
-    const vtk_result *any = NULL;
-    double vtk_seconds = 0.0;
-    for (int d = 0; d < DATASET_COUNT; d++) {
-        vtk_seconds += rows[d].vtk.seconds;
-        if (rows[d].vtk.ok && !any)
-            any = &rows[d].vtk;
-    }
-    const sl_technique *mesh_t = sl_technique_find("tubes_mesh");
-    sl_params mp;
-    sl_params_init(&mp, mesh_t->params, mesh_t->param_count);
-    printf("\n## Against VTK's tube filter (%dx%d, median of %d orbit frames, ms)\n\n", o->width, o->height, o->frames);
-    printf("The same lines, radius, image size, cameras and orbit through VTK %s: vtkTubeFilter (%d sides, %s, as "
-           "tubes_mesh's defaults) and vtkPolyDataMapper, no multisampling, under xvfb-run (GL: %s). Frame ms here are "
-           "wall time of a frame until glFinish for all three (VTK: Render + glFinish + 1-pixel readback; ours: "
-           "render + resolve + glFinish), so they exceed the GPU-timer ms of the table above. Ratio = our ms / VTK "
-           "ms (below 1: ours is faster). Preprocessing: VTK's tube filter, and its first frame (which uploads the "
-           "mesh), against tubes_mesh's prepare (CPU mesh build + upload).\n\n",
-           any ? any->version : "(not run)", sl_params_int(&mp, "sides"), sl_params_bool(&mp, "caps") ? "capped" : "open",
-           any ? any->gl : "-");
-    printf("| dataset | view | VTK | tubes | tubes_mesh | tubes / VTK | tubes_mesh / VTK | VTK tube filter | "
-           "VTK first frame | tubes_mesh prepare | VTK triangles |\n");
-    printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (int d = 0; d < DATASET_COUNT; d++) {
-        if (!rows[d].done)
-            continue;
-        const vtk_result *r = &rows[d].vtk;
-        for (int v = 0; v < VTK_VIEWS; v++) {
-            const run_result *rt = &rows[d].tubes[v], *rm = &rows[d].mesh[v];
-            if (!r->ok) {
-                printf("| %s | %s | VTK: not available (%s) | %.1f | %.1f | | | | | %.0f | |\n", datasets[d].name,
-                       names[v], r->reason[0] ? r->reason : vtk_unavailable, rt->wall_ms, rm->wall_ms, rm->prepare_ms);
-                continue;
-            }
-            printf("| %s | %s | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %.0f | %.0f | %.0f |\n", datasets[d].name,
-                   names[v], r->ms[v], rt->wall_ms, rm->wall_ms, r->ms[v] > 0 ? rt->wall_ms / r->ms[v] : 0.0,
-                   r->ms[v] > 0 ? rm->wall_ms / r->ms[v] : 0.0, r->filter_ms, r->first_frame_ms, rm->prepare_ms,
-                   r->triangles);
-        }
-    }
-    if (vtk_seconds > 0.0)
-        printf("\n(The VTK runs took %.0f s in all, start-up of Xvfb and Python included.)\n", vtk_seconds);
-    fflush(stdout);
+    printf("\n(tubes triangles: box faces emitted by the geometry shader per box pass, 2 per face, after culling. "
+           "n/a: the peer did not run; bench-tubes says why on stderr.)\n");
+    sl_bench_print_gpu_note();
     return SL_OK;
 }
 
@@ -542,11 +237,21 @@ static sl_status reference_of(const sl_dataset *ds, const sl_view *view, const s
     return SL_OK;
 }
 
+/* The one camera of the error table, for every frame. */
+static sl_status fixed_camera(const sl_dataset *ds, int frame, int frames, const void *ctx, sl_camera *camera,
+                              sl_err *err)
+{
+    (void)ds, (void)frame, (void)frames, (void)err;
+    *camera = *(const sl_camera *)ctx;
+    return SL_OK;
+}
+
 static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
 {
     const char *json = "{\"generator\":\"bundle\",\"lines\":100,\"points\":50,\"seed\":2}";
-    (void)o;
     const int w = 128, h = 128;
+    sl_bench_options one = o->bench;
+    one.frames = 1;
     sl_dataset *ds = NULL;
     sl_status st = sl_generate_json(json, &ds, err);
     if (st != SL_OK)
@@ -577,8 +282,8 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
            "tube radius; \"away\" excludes reference silhouettes (3x3 coverage change or depth jump > radius; "
            "tests/render/tubes/tubes_reference.c tubes_ref_silhouette).\n\n", segs, w, h);
     printf("| method | iterations | max error (away) | max error (all) | mean error | pixels (away / both hit) | "
-           "coverage mismatch | frame ms |\n");
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+           "coverage mismatch | frame ms %dx%d | frame ms %dx%d |\n", w, h, one.width, one.height);
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     /* Every count up to 12: a coarse grid would hide the real fewest count. */
     static const int iters[] = {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 16, 20, 24, 32};
     const int ni = (int)(sizeof iters / sizeof iters[0]);
@@ -610,15 +315,19 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
             for (int f = 0; f < 3; f++) {
                 if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
                     goto done;
-                ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
+                ms[f] = stats.wall_ms;
             }
             sl_pipeline_read_distance(p, &view, gpu_d);
+            sl_bench_timing big;
+            if ((st = sl_bench_time_frames(p, tubes, &params, &one, SL_QUALITY_STILL, fixed_camera, &view.camera, &big,
+                                           err)) != SL_OK)
+                goto done;
             error_stats e = compare(gpu_d, ref, rad, w, h);
             for (int l = 0; l < NL; l++)
                 if (need[m][l] < 0 && e.max_inner <= levels[l] && e.mean <= 0.1 * levels[l])
                     need[m][l] = iters[k];
-            printf("| %s | %d | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f |\n", methods[m], iters[k], e.max_inner,
-                   e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3));
+            printf("| %s | %d | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f | %.1f |\n", methods[m], iters[k],
+                   e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3), big.median_ms);
             fflush(stdout);
         }
     }
@@ -765,32 +474,24 @@ static sl_status bench_cubic(const options *o, sl_err *err)
 
 int main(int argc, char **argv)
 {
-    options o = {.width = 160, .height = 90, .frames = 3};
+    options o = {0};
+    sl_bench_options_init(&o.bench, 3);
     for (int i = 1; i < argc; i++) {
+        int c = sl_bench_option(&o.bench, argc, argv, &i, "bench-tubes");
+        if (c < 0)
+            return 1;
+        if (c > 0)
+            continue;
         const char *a = argv[i];
         if (strcmp(a, "--skip-perf") == 0) o.skip_perf = 1;
         else if (strcmp(a, "--skip-error") == 0) o.skip_error = 1;
         else if (strcmp(a, "--skip-cubic") == 0) o.skip_cubic = 1;
-        else if (strcmp(a, "--skip-vtk") == 0) o.skip_vtk = 1;
-        else if (strcmp(a, "--vtk-png") == 0 && i + 1 < argc) o.vtk_png = argv[++i];
-        else if (strcmp(a, "--size") == 0 && i + 1 < argc) {
-            if (sscanf(argv[++i], "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 ||
-                o.width > 8192 || o.height > 8192) {
-                fprintf(stderr, "bench-tubes: --size WxH, 1..8192\n");
-                return 1;
-            }
-        } else if (strcmp(a, "--frames") == 0 && i + 1 < argc) {
-            o.frames = atoi(argv[++i]);
-            if (o.frames < 1 || o.frames > 100000) {
-                fprintf(stderr, "bench-tubes: --frames in [1, 100000]\n");
-                return 1;
-            }
-        } else if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
-            o.only = argv[++i];
-        } else {
-            fprintf(stderr, "usage: bench-tubes [--size WxH] [--frames N] [--datasets fibers,hotroom,bundle,brain,furball]\n"
-                            "                   [--skip-perf] [--skip-error] [--skip-cubic] [--skip-vtk]\n"
-                            "                   [--vtk-png PREFIX]\n");
+        else if (strcmp(a, "--skip-peers") == 0) o.skip_peers = 1;
+        else if (strcmp(a, "--datasets") == 0 && i + 1 < argc) o.only = argv[++i];
+        else {
+            fprintf(stderr, "usage: bench-tubes %s [--datasets fibers,hotroom,bundle,brain,furball]\n"
+                            "                   [--skip-perf] [--skip-error] [--skip-cubic] [--skip-peers]\n",
+                    SL_BENCH_OPTIONS_HELP);
             return 1;
         }
     }

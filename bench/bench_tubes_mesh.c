@@ -1,6 +1,6 @@
 /* bench_tubes_mesh.c — run time against error of the `tubes_mesh` baseline, per cross-section size.
  *
- *   bench-tubes-mesh [--size WxH] [--frames N] [--sides 6,8,12,16,24,30]
+ *   bench-tubes-mesh [--small | --size WxH] [--frames N] [--sides 6,8,12,16,24,30]
  *
  * The only accuracy knob of a swept-circle mesh is `sides` (n vertices per
  * ring): the prism lies inside the true tube, so the depth error is at most
@@ -11,9 +11,11 @@
  *    matrices): max and mean |error| / r over the pixels both hit, max over
  *    pixels hit nearly head-on (incidence cosine >= 0.9) next to the bound,
  *    and coverage mismatch.
- * 2. Time: median GPU ms over an orbit of N frames on the built-in tornado
- *    (1000 lines x 200 points) and furball (100k segments), far view,
- *    triangles, prepare ms and GPU memory, with the ratio to the default n.
+ * 2. Time through the harness (bench/harness/sl_bench.h: wall ms to glFinish
+ *    after the readback, an orbit of N frames after a warm-up, default
+ *    1280x720) on the built-in tornado (1000 lines x 200 points) and furball
+ *    (100k segments), far view: median / min / max, GPU-timer ms, triangles,
+ *    prepare ms, GPU memory and peak RSS, with the ratio to the default n.
  * Prints Markdown; checks nothing (tests/render/tubes_mesh.cmake does).
  */
 #include <cjson/cJSON.h>
@@ -27,29 +29,30 @@
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
+#include "harness/sl_bench.h"
 
 #define MAX_SIDES 16
 
 typedef struct options {
-    int width, height, frames;
+    sl_bench_options bench;
+    int width, height, frames; /* copies of bench's */
     int sides[MAX_SIDES];
     int side_count;
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
 {
-    *o = (options){.width = 256, .height = 144, .frames = 5, .sides = {6, 8, 12, 16, 24, 30}, .side_count = 6};
-    for (int i = 1; i < argc; i += 2) {
+    *o = (options){.sides = {6, 8, 12, 16, 24, 30}, .side_count = 6};
+    sl_bench_options_init(&o->bench, 5);
+    for (int i = 1; i < argc; i++) {
+        int c = sl_bench_option(&o->bench, argc, argv, &i, "bench-tubes-mesh");
+        if (c < 0)
+            return 0;
+        if (c > 0)
+            continue;
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--size") == 0 && v) {
-            if (sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width < 16 || o->height < 16 ||
-                o->width > 8192 || o->height > 8192)
-                return fprintf(stderr, "bench-tubes-mesh: --size must be WxH in [16, 8192]\n"), 0;
-        } else if (strcmp(a, "--frames") == 0 && v) {
-            o->frames = atoi(v);
-            if (o->frames < 1 || o->frames > 100000)
-                return fprintf(stderr, "bench-tubes-mesh: --frames must be in [1, 100000]\n"), 0;
-        } else if (strcmp(a, "--sides") == 0 && v) {
+        if (strcmp(a, "--sides") == 0 && v) {
+            i++;
             o->side_count = 0;
             for (const char *p = v; *p && o->side_count < MAX_SIDES;) {
                 int n = (int)strtol(p, (char **)&p, 10);
@@ -62,23 +65,14 @@ static int parse_args(int argc, char **argv, options *o)
                     return fprintf(stderr, "bench-tubes-mesh: --sides is a comma-separated list\n"), 0;
             }
         } else {
-            fprintf(stderr, "usage: bench-tubes-mesh [--size WxH] [--frames N] [--sides 6,8,12,...]\n");
+            fprintf(stderr, "usage: bench-tubes-mesh %s [--sides 6,8,12,...]\n", SL_BENCH_OPTIONS_HELP);
             return 0;
         }
     }
+    o->width = o->bench.width;
+    o->height = o->bench.height;
+    o->frames = o->bench.frames;
     return 1;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 static sl_status set_technique(sl_pipeline *p, int sides, sl_err *err)
@@ -209,7 +203,7 @@ static sl_status measure_error(sl_gpu *gpu, const options *o, int sides, error_r
 
 /* ---- 2. frame time on generated data ---- */
 
-typedef struct time_row { double ms, prepare_ms, triangles, mb; } time_row;
+typedef struct time_row { sl_bench_timing t; } time_row;
 
 static sl_status measure_time(sl_gpu *gpu, const options *o, const char *builtin, const int *sides, int count,
                               time_row *rows, sl_err *err)
@@ -219,32 +213,16 @@ static sl_status measure_time(sl_gpu *gpu, const options *o, const char *builtin
     sl_pipeline *p = NULL;
     if (st != SL_OK || (st = pipeline_for(gpu, ds, &p, err)) != SL_OK)
         return st;
-    double *ms = malloc((size_t)o->frames * sizeof *ms);
-    if (!ms)
-        st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    const sl_technique *t = sl_technique_find("tubes_mesh");
+    const sl_bench_orbit orbit = {.distance = 2.5, .elevation_deg = 20, .fov_y_deg = 45};
     for (int s = 0; st == SL_OK && s < count; s++) {
-        if ((st = set_technique(p, sides[s], err)) != SL_OK)
+        sl_params params;
+        sl_params_init(&params, t->params, t->param_count);
+        if ((st = sl_bench_set(&params, "sides", sides[s], err)) != SL_OK)
             break;
-        sl_frame_stats stats = {0};
-        for (int f = -1; st == SL_OK && f < o->frames; f++) { /* frame -1 prepares, untimed */
-            sl_view view = {.width = o->width, .height = o->height, .origin = ds->origin, .background = {0, 0, 0, 1}};
-            sl_orbit orbit = {360.0 * (f < 0 ? 0 : f) / o->frames, 20.0, 2.5, 45.0};
-            if ((st = sl_camera_from_orbit(&orbit, ds->bounds_min, ds->bounds_max, &view.camera, err)) != SL_OK ||
-                (st = sl_view_init(&view, sl_dataset_radius(ds), err)) != SL_OK ||
-                (st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
-                break;
-            if (f < 0)
-                rows[s].prepare_ms = stats.prepare_ms;
-            else
-                ms[f] = stats.gpu_ms > 0.0 ? stats.gpu_ms : stats.wall_ms;
-        }
-        if (st == SL_OK) {
-            rows[s].ms = median(ms, o->frames);
-            rows[s].triangles = stats.render.primitives;
-            rows[s].mb = (double)stats.gpu_bytes / (1024.0 * 1024.0);
-        }
+        st = sl_bench_time_frames(p, t, &params, &o->bench, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit,
+                                  &rows[s].t, err);
     }
-    free(ms);
     sl_pipeline_destroy(p);
     return st;
 }
@@ -277,21 +255,28 @@ int main(int argc, char **argv)
     }
     static const char *const datasets[] = {"tornado", "furball"};
     for (int d = 0; st == SL_OK && d < 2; d++) {
-        time_row rows[MAX_SIDES] = {{0}};
+        time_row rows[MAX_SIDES];
+        memset(rows, 0, sizeof rows);
         if ((st = measure_time(gpu, &o, datasets[d], o.sides, o.side_count, rows, &err)) != SL_OK)
             break;
         int ref = 0;
         for (int s = 0; s < o.side_count; s++)
             if (o.sides[s] == 12)
                 ref = s;
-        printf("\n## Frame time, built-in `%s` (%dx%d, far orbit, median of %d frames)\n\n", datasets[d], o.width,
+        printf("\n## Frame time, built-in `%s` (%dx%d, far orbit of %d frames after a warm-up)\n\n", datasets[d], o.width,
                o.height, o.frames);
-        printf("| sides | GPU ms | ratio to %d sides | triangles | prepare ms | GPU MB |\n", o.sides[ref]);
-        printf("|---:|---:|---:|---:|---:|---:|\n");
-        for (int s = 0; s < o.side_count; s++)
-            printf("| %d | %.2f | %.2f | %.0f | %.0f | %.1f |\n", o.sides[s], rows[s].ms,
-                   rows[ref].ms > 0.0 ? rows[s].ms / rows[ref].ms : 0.0, rows[s].triangles, rows[s].prepare_ms,
-                   rows[s].mb);
+        printf("| sides | wall ms median (min-max) | GPU ms | ratio to %d sides | triangles | prepare ms | GPU MB | "
+               "peak RSS MB |\n", o.sides[ref]);
+        printf("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (int s = 0; s < o.side_count; s++) {
+            const sl_bench_timing *t = &rows[s].t;
+            char gpu_cell[32];
+            printf("| %d | %.1f (%.1f-%.1f) | %s | %.2f | %.0f | %.0f | %.1f | %.0f |\n", o.sides[s], t->median_ms,
+                   t->min_ms, t->max_ms, sl_bench_gpu_cell(t, gpu_cell, sizeof gpu_cell),
+                   rows[ref].t.median_ms > 0.0 ? t->median_ms / rows[ref].t.median_ms : 0.0, t->primitives,
+                   t->prepare_ms, t->gpu_bytes / 1048576.0, t->peak_rss_mb);
+        }
+        sl_bench_print_gpu_note();
     }
     if (st != SL_OK)
         fprintf(stderr, "bench-tubes-mesh: %s\n", err.message);

@@ -4,14 +4,17 @@
  * the paper counts it) and CPU / GPU preprocessing time per grid V^3 and
  * quantization Q^2, next to the original geometry (3 floats + 1 byte per
  * vertex) and the linked-list memory lines_oit needed at 25 % opacity.
- * Table 2: median GPU frame ms at 25 % opacity (lines_oit vs voxel_lines,
- * still = with neighbour search, and interactive = own voxel only) and
- * opaque (tubes_mesh vs voxel_lines), with ratios, and GPU memory.
+ * Table 2: median wall frame ms through the harness (bench/harness/sl_bench.h:
+ * render + readback + glFinish, an orbit after a warm-up) at 25 % opacity
+ * (lines_oit vs voxel_lines, still = with neighbour search, and interactive =
+ * own voxel only) and opaque (tubes_mesh vs voxel_lines), with ratios, GPU
+ * memory and the GPU-timer ms as a second column (flagged where it missed
+ * the work: on llvmpipe it does for voxel_lines).
  * Datasets stand in for the paper's (generator, lines x points): Tornado
  * (tornado 1000x250), Aneurysm I/II (bundle 4700x410, 9200x367), Turbulence
  * (abc 50000x220), Forecast (abc 212000x13). --scale multiplies the line
  * counts (default 0.05, so the whole run takes minutes on llvmpipe).
- * Usage: bench-voxel-lines [--scale S] [--size N] [--frames N] [--grid V] [--quant Q]
+ * Usage: bench-voxel-lines [--scale S] [--small | --size WxH] [--frames N] [--grid V] [--quant Q]
  *        [--table1-grids 256/128,256/32,128/128,128/32,64/8] [--only NAME] [--no-table1] [--no-table2]
  * Runs on the main thread, which owns the GL context.
  */
@@ -22,6 +25,7 @@
 
 #include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"
+#include "harness/sl_bench.h"
 #include "pipeline/sl_pipeline.h"
 #include "voxel_lines/voxel_gpu.h"
 #include "voxel_lines/voxel_grid.h"
@@ -42,54 +46,38 @@ static const bench_data datasets[] = {
 
 typedef struct options {
     double scale;
-    int size, frames, grid, quant;
+    sl_bench_options bench;
+    int grid, quant;
     int t1_grid[8], t1_quant[8], t1_count;
     const char *only;
     int table1, table2;
 } options;
 
-static int cmp_double(const void *a, const void *b)
+/* Times one technique through the harness; *t->median_ms is NAN on error. */
+static void time_technique(sl_pipeline *pipe, const char *name, double opacity, const options *o, sl_quality quality,
+                           const sl_bench_orbit *orbit, sl_bench_timing *t)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y);
-}
-
-/* Median GPU ms over o->frames frames after one warm-up frame; NAN on error. */
-static double time_technique(sl_pipeline *pipe, const char *name, double opacity, const options *o,
-                             const sl_view *view, size_t *bytes)
-{
-    const sl_technique *t = sl_technique_find(name);
+    const sl_technique *tech = sl_technique_find(name);
     sl_params p;
     sl_err err = {0};
-    sl_params_init(&p, t->params, t->param_count);
-    double grid = o->grid, attribute = -1;
+    sl_params_init(&p, tech->params, tech->param_count);
     char q[16];
     snprintf(q, sizeof q, "%d", o->quant);
-    sl_status st = sl_params_set_numbers(&p, "attribute", &attribute, 1, &err);
+    sl_status st = sl_bench_set(&p, "attribute", -1, &err);
     if (st == SL_OK && sl_params_find(&p, "opacity") >= 0)
-        st = sl_params_set_numbers(&p, "opacity", &opacity, 1, &err);
+        st = sl_bench_set(&p, "opacity", opacity, &err);
     if (st == SL_OK && strcmp(name, "voxel_lines") == 0) {
-        st = sl_params_set_numbers(&p, "grid", &grid, 1, &err);
+        st = sl_bench_set(&p, "grid", o->grid, &err);
         if (st == SL_OK)
-            st = sl_params_set_choice(&p, "quantization", q, &err);
+            st = sl_bench_set_choice(&p, "quantization", q, &err);
     }
     if (st == SL_OK)
-        st = sl_pipeline_set_technique(pipe, t, &p, &err);
-    double ms[64];
-    int n = o->frames < 64 ? o->frames : 64;
-    for (int f = -1; f < n && st == SL_OK; f++) {
-        sl_frame_stats stats;
-        st = sl_pipeline_render(pipe, view, 1, &stats, &err);
-        if (f >= 0)
-            ms[f] = stats.gpu_ms;
-        *bytes = stats.gpu_bytes;
-    }
+        st = sl_bench_time_frames(pipe, tech, &p, &o->bench, quality, sl_bench_orbit_camera, orbit, t, &err);
     if (st != SL_OK) {
         fprintf(stderr, "bench-voxel-lines: %s: %s\n", name, err.message);
-        return NAN;
+        memset(t, 0, sizeof *t);
+        t->median_ms = NAN;
     }
-    qsort(ms, (size_t)n, sizeof ms[0], cmp_double);
-    return ms[n / 2];
 }
 
 static int parse_settings(const char *s, options *o)
@@ -112,16 +100,20 @@ static int parse_settings(const char *s, options *o)
 
 int main(int argc, char **argv)
 {
-    options o = {.scale = 0.05, .size = 128, .frames = 3, .grid = 128, .quant = 32, .table1 = 1, .table2 = 1};
+    options o = {.scale = 0.05, .grid = 128, .quant = 32, .table1 = 1, .table2 = 1};
+    sl_bench_options_init(&o.bench, 3);
     parse_settings("256/128,256/32,128/128,128/32,64/8", &o);
     for (int i = 1; i < argc; i++) {
+        int c = sl_bench_option(&o.bench, argc, argv, &i, "bench-voxel-lines");
+        if (c < 0)
+            return 2;
+        if (c > 0)
+            continue;
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : "";
         if (strcmp(a, "--no-table1") == 0) { o.table1 = 0; continue; }
         if (strcmp(a, "--no-table2") == 0) { o.table2 = 0; continue; }
         i++;
         if (strcmp(a, "--scale") == 0) o.scale = atof(v);
-        else if (strcmp(a, "--size") == 0) o.size = atoi(v);
-        else if (strcmp(a, "--frames") == 0) o.frames = atoi(v);
         else if (strcmp(a, "--grid") == 0) o.grid = atoi(v);
         else if (strcmp(a, "--quant") == 0) o.quant = atoi(v);
         else if (strcmp(a, "--only") == 0) o.only = v;
@@ -131,12 +123,13 @@ int main(int argc, char **argv)
                 return 2;
             }
         } else {
-            fprintf(stderr, "usage: bench-voxel-lines [--scale S] [--size N] [--frames N] [--grid V] [--quant Q]\n"
-                            "       [--table1-grids V/Q,...] [--only NAME] [--no-table1] [--no-table2]\n");
+            fprintf(stderr, "usage: bench-voxel-lines [--scale S] %s [--grid V] [--quant Q]\n"
+                            "       [--table1-grids V/Q,...] [--only NAME] [--no-table1] [--no-table2]\n",
+                    SL_BENCH_OPTIONS_HELP);
             return 2;
         }
     }
-    if (!(o.scale > 0.0 && o.scale <= 1.0) || o.size < 16 || o.size > 4096 || o.frames < 1 ||
+    if (!(o.scale > 0.0 && o.scale <= 1.0) ||
         sl_voxel_quant_bits(o.quant) < 0 || o.grid < 0 || o.grid > 512) {
         fprintf(stderr, "bench-voxel-lines: bad option value\n");
         return 2;
@@ -149,9 +142,10 @@ int main(int argc, char **argv)
         sl_gpu_destroy(gpu);
         return 3;
     }
-    printf("# voxel_lines benchmark\n\nGPU: %s. Line counts x %.3g of the paper's; image %dx%d; median of %d frames "
-           "after a warm-up; radius automatic (1/300 of the bounding radius); still quality.\n\n",
-           sl_gpu_renderer(gpu), o.scale, o.size, o.size, o.frames);
+    printf("# voxel_lines benchmark\n\nGPU: %s. Line counts x %.3g of the paper's; image %dx%d; median wall ms of an "
+           "orbit of %d frames after a warm-up (render + readback + glFinish); radius automatic (1/300 of the bounding "
+           "radius); constant colour; still quality unless said.\n\n",
+           sl_gpu_renderer(gpu), o.scale, o.bench.width, o.bench.height, o.bench.frames);
 
     char t1[DATASET_COUNT][1024], t2[DATASET_COUNT][1024];
     int rows = 0;
@@ -192,35 +186,28 @@ int main(int argc, char **argv)
                 sl_voxel_grid_deinit(&g);
             }
         }
-        sl_vec3 lo = ds->bounds_min, hi = ds->bounds_max;
-        double radius = sl_dataset_radius(ds);
-        sl_view view = {.width = o.size, .height = o.size, .quality = SL_QUALITY_STILL,
-                        .background = {0.1f, 0.1f, 0.12f, 1.0f}, .origin = ds->origin};
-        sl_orbit orbit = {.azimuth_deg = 30, .elevation_deg = 20, .distance = 2.2, .fov_y_deg = 45};
         sl_pipeline_set_dataset(pipe, ds);
-        if (sl_camera_from_orbit(&orbit, lo, hi, &view.camera, &err) != SL_OK ||
-            sl_view_init(&view, radius, &err) != SL_OK) {
-            fprintf(stderr, "bench-voxel-lines: camera: %s\n", err.message);
-            continue;
-        }
-        size_t b_oit = 0, b_vt = 0, b_mesh = 0, b_vo = 0, b_vi = 0;
-        double oit = NAN, vt = NAN, mesh = NAN, vo = NAN, vi = NAN;
+        const sl_bench_orbit orbit = {.distance = 2.2, .elevation_deg = 20, .fov_y_deg = 45};
+        sl_bench_timing oit = {0}, vt = {0}, mesh = {0}, vo = {0}, vi = {0};
+        oit.median_ms = vt.median_ms = mesh.median_ms = vo.median_ms = vi.median_ms = NAN;
+        time_technique(pipe, "lines_oit", 0.25, &o, SL_QUALITY_STILL, &orbit, &oit);
         if (o.table2) {
-            oit = time_technique(pipe, "lines_oit", 0.25, &o, &view, &b_oit);
-            vt = time_technique(pipe, "voxel_lines", 0.25, &o, &view, &b_vt);
-            sl_view moving = view;
-            moving.quality = SL_QUALITY_INTERACTIVE; /* own voxel only, as while the camera moves */
-            vi = time_technique(pipe, "voxel_lines", 0.25, &o, &moving, &b_vi);
-            mesh = time_technique(pipe, "tubes_mesh", 1.0, &o, &view, &b_mesh);
-            vo = time_technique(pipe, "voxel_lines", 1.0, &o, &view, &b_vo);
-        } else {
-            oit = time_technique(pipe, "lines_oit", 0.25, &o, &view, &b_oit);
+            time_technique(pipe, "voxel_lines", 0.25, &o, SL_QUALITY_STILL, &orbit, &vt);
+            /* own voxel only, as while the camera moves */
+            time_technique(pipe, "voxel_lines", 0.25, &o, SL_QUALITY_INTERACTIVE, &orbit, &vi);
+            time_technique(pipe, "tubes_mesh", 1.0, &o, SL_QUALITY_STILL, &orbit, &mesh);
+            time_technique(pipe, "voxel_lines", 1.0, &o, SL_QUALITY_STILL, &orbit, &vo);
         }
-        snprintf(t1[rows] + n, sizeof t1[rows] - (size_t)n, " | %.1f MB |", b_oit / 1e6);
+        snprintf(t1[rows] + n, sizeof t1[rows] - (size_t)n, " | %.1f MB |", oit.gpu_bytes / 1e6);
+        char g_oit[32], g_vt[32], g_mesh[32], g_vo[32];
         snprintf(t2[rows], sizeof t2[rows],
-                 "| %s | %.1f ms (%.0f MB) | %.1f ms (%.0f MB) | **%.2fx** | %.1f ms (%.2fx) | %.1f ms (%.0f MB) | %.1f ms "
-                 "| **%.2fx** |",
-                 bd->name, oit, b_oit / 1e6, vt, b_vt / 1e6, oit / vt, vi, oit / vi, mesh, b_mesh / 1e6, vo, mesh / vo);
+                 "| %s | %.0f ms (%.0f MB, RSS %.0f) | %.0f ms (%.0f MB, RSS %.0f) | **%.2fx** | %.0f ms (%.2fx) | %.0f ms "
+                 "(%.0f MB) | %.0f ms (%.0f MB) | **%.2fx** | %s / %s / %s / %s |",
+                 bd->name, oit.median_ms, oit.gpu_bytes / 1e6, oit.peak_rss_mb, vt.median_ms, vt.gpu_bytes / 1e6,
+                 vt.peak_rss_mb, oit.median_ms / vt.median_ms, vi.median_ms, oit.median_ms / vi.median_ms,
+                 mesh.median_ms, mesh.gpu_bytes / 1e6, vo.median_ms, vo.gpu_bytes / 1e6, mesh.median_ms / vo.median_ms,
+                 sl_bench_gpu_cell(&oit, g_oit, sizeof g_oit), sl_bench_gpu_cell(&vt, g_vt, sizeof g_vt),
+                 sl_bench_gpu_cell(&mesh, g_mesh, sizeof g_mesh), sl_bench_gpu_cell(&vo, g_vo, sizeof g_vo));
         fprintf(stderr, "%s done\n", bd->name);
         rows++;
     }
@@ -238,12 +225,14 @@ int main(int argc, char **argv)
         printf("\n(* = some voxels exceeded 255 lines; the excess was dropped and counted)\n\n");
     }
     if (o.table2) {
-        printf("## Table 2 — median GPU frame time, voxel grid %d^3 (0 = auto) / %d^2\n\n"
+        printf("## Table 2 — median wall frame time, voxel grid %d^3 (0 = auto) / %d^2\n\n"
                "| Dataset | lines_oit 25%% | voxel_lines 25%% still | OIT / voxel | voxel_lines 25%% interactive (ratio) "
-               "| tubes_mesh opaque | voxel_lines opaque still | mesh / voxel |\n|---|---|---|---|---|---|---|---|\n",
+               "| tubes_mesh opaque | voxel_lines opaque still | mesh / voxel | GPU-timer ms: OIT / voxel 25%% / mesh / "
+               "voxel opaque |\n|---|---|---|---|---|---|---|---|---|\n",
                o.grid, o.quant);
         for (int r = 0; r < rows; r++)
             printf("%s\n", t2[r]);
+        sl_bench_print_gpu_note();
         printf("\n");
     }
     sl_pipeline_destroy(pipe);

@@ -53,6 +53,7 @@ extern const sl_gen_family sl_gen_abc;
 extern const sl_gen_family sl_gen_bundle;
 extern const sl_gen_family sl_gen_furball;
 extern const sl_gen_family sl_gen_hotroom;
+extern const sl_gen_family sl_gen_random_walk;
 extern const sl_gen_family sl_gen_marschner_lobb;
 extern const sl_gen_family sl_gen_torus;
 extern const sl_gen_family sl_gen_head;

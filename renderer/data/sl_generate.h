@@ -8,7 +8,7 @@
  * identical and the values agree up to libm's last-bit rounding (sin, cos,
  * exp may differ by an ulp between libm versions or with FMA); test_generate
  * pins both per family.
- * Families — lines: tornado, abc, bundle, furball, hotroom;
+ * Families — lines: tornado, abc, bundle, furball, hotroom, random_walk;
  *            volumes: marschner_lobb, torus, head.
  * Any thread; no GL.
  */

@@ -102,7 +102,7 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
                                                  .label = "lines_oit_collect"},
                               &s->collect, err);
     if (st == SL_OK)
-        st = sl_gl_program_create(&(sl_program_desc){.vertex = "lines_oit/lines_oit_fullscreen.vert.glsl",
+        st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
                                                      .fragment = "lines_oit/lines_oit_resolve.frag.glsl",
                                                      .label = "lines_oit_resolve"},
                                   &s->resolve, err);

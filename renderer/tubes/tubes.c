@@ -9,8 +9,12 @@
  * move re-uploads nothing; radius, colour and root-search parameters are
  * uniforms (an attribute change re-fills the small scalar buffer; a
  * radius_attribute change re-prepares: radii live in the node buffer). An
- * attribute index the dataset lacks is an error (sl_line_style_check). Does not
- * do transparency or level of detail. Render thread only (GL).
+ * attribute index the dataset lacks is an error (sl_line_style_check).
+ * occlusion_prepass (default, beyond the paper; render_with_prepass): an
+ * occluder depth pre-pass of spheres inside the sweep lets early depth tests
+ * reject hidden boxes before their root search — on llvmpipe a discard does
+ * not skip the rest of a shader, only a rejected fragment skips all of it.
+ * Does not do transparency or level of detail. Render thread only (GL).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -40,6 +44,10 @@ static const sl_param_def tubes_params[] = {
     {"small_box_pixels", SL_PARAM_FLOAT, 0, 65536, {64}, NULL, "px",
      "a box whose projection spans at most this many pixels is drawn as one screen rectangle instead of its faces "
      "(4 vertices instead of up to 12; 0: always faces, as the paper)", SL_INVALIDATE_FRAME},
+    {"occlusion_prepass", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
+     "occluder depth pre-pass (three inscribed squares per segment), then early depth tests keep hidden boxes "
+     "from the root search: two box passes instead of one, far fewer root searches where tubes hide each other",
+     SL_INVALIDATE_FRAME},
     {"silhouette_only", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
      "discard every fragment (measures the silhouette cost; draws nothing)", SL_INVALIDATE_FRAME},
 };
@@ -47,7 +55,10 @@ static const sl_param_def tubes_params[] = {
 typedef struct tubes_state {
     const sl_dataset *dataset;   /* borrowed */
     sl_tubes_nodes nodes;        /* CPU copy of the colour scalars (geometry freed after upload) */
-    GLuint program, program_silhouette;
+    GLuint program, program_silhouette;      /* one pass (the paper's), and its silhouette experiment */
+    GLuint program_prepass, program_depth, program_nearest, program_shade; /* occlusion_prepass passes */
+    GLuint nearest_tex;          /* r32ui, nearest_w x nearest_h: nearest hit depth bits per pixel */
+    int nearest_w, nearest_h;
     GLuint vao, node_vbo, color_vbo, ibo, colormap_tex, camera_ubo, query;
     int colormap_loaded;         /* colormap index in colormap_tex, or -1 */
     int attribute_loaded;        /* attribute in color_vbo, or -2 */
@@ -62,6 +73,11 @@ static void tubes_release(void *opaque)
         return;
     if (s->program) glDeleteProgram(s->program);
     if (s->program_silhouette) glDeleteProgram(s->program_silhouette);
+    if (s->program_prepass) glDeleteProgram(s->program_prepass);
+    if (s->program_depth) glDeleteProgram(s->program_depth);
+    if (s->program_nearest) glDeleteProgram(s->program_nearest);
+    if (s->program_shade) glDeleteProgram(s->program_shade);
+    if (s->nearest_tex) glDeleteTextures(1, &s->nearest_tex);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->node_vbo) glDeleteBuffers(1, &s->node_vbo);
     if (s->color_vbo) glDeleteBuffers(1, &s->color_vbo);
@@ -105,6 +121,28 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
                                                       .fragment = "tubes/tubes_silhouette.frag.glsl",
                                                       .label = "tubes_silhouette"},
                                    &s->program_silhouette, err)) != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes_prepass.vert.glsl",
+                                                      .fragment = "tubes/tubes_prepass.frag.glsl",
+                                                      .label = "tubes_prepass"},
+                                   &s->program_prepass, err)) != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
+                                                      .geometry = "tubes/tubes.geom.glsl",
+                                                      .fragment = "tubes/tubes_depth.frag.glsl",
+                                                      .label = "tubes_depth"},
+                                   &s->program_depth, err)) != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
+                                                      .fragment = "tubes/tubes_nearest_depth.frag.glsl",
+                                                      .label = "tubes_nearest_depth"},
+                                   &s->program_nearest, err)) != SL_OK)
+        goto fail;
+    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
+                                                      .geometry = "tubes/tubes.geom.glsl",
+                                                      .fragment = "tubes/tubes_shade.frag.glsl",
+                                                      .label = "tubes_shade"},
+                                   &s->program_shade, err)) != SL_OK)
         goto fail;
 
     double t_upload = sl_now_ms();
@@ -170,6 +208,94 @@ static void set_uniforms(GLuint program, const sl_line_style *style, const sl_pa
     glUniform1i(glGetUniformLocation(program, "u_colormap"), 0);
 }
 
+/* (Re)creates the per-pixel nearest-hit image at the view's size. */
+static sl_status ensure_nearest_image(tubes_state *s, int w, int h, sl_err *err)
+{
+    if (s->nearest_tex && s->nearest_w == w && s->nearest_h == h)
+        return SL_OK;
+    if (s->nearest_tex)
+        glDeleteTextures(1, &s->nearest_tex);
+    s->nearest_w = s->nearest_h = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->nearest_tex);
+    glTextureStorage2D(s->nearest_tex, 1, GL_R32UI, w, h);
+    GLenum gl_error = glGetError();
+    if (gl_error != GL_NO_ERROR)
+        return sl_err_set(err, SL_ERR_GPU, "tubes: nearest-hit image %dx%d failed (GL error 0x%x)", w, h, gl_error);
+    s->nearest_w = w;
+    s->nearest_h = h;
+    return SL_OK;
+}
+
+/* Draws every segment's boxes with program (uniforms set), counting emitted triangles into stats. */
+static void draw_boxes(tubes_state *s, sl_render_stats *stats)
+{
+    glBindVertexArray(s->vao);
+    glBeginQuery(GL_PRIMITIVES_GENERATED, s->query);
+    glDrawElements(GL_LINES, (GLsizei)(2 * s->nodes.segment_count), GL_UNSIGNED_INT, NULL);
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    glBindVertexArray(0);
+    GLuint triangles = 0;
+    glGetQueryObjectuiv(s->query, GL_QUERY_RESULT, &triangles);
+    stats->primitives = (double)triangles; /* triangles rasterized (2 per face) */
+}
+
+/* occlusion_prepass: four passes into the bound target (depth cleared to 0 = nothing).
+ * 1. tubes_prepass: inscribed squares, depth only: D never behind the nearest hit.
+ * 2. tubes_depth: boxes with early tests GREATER against D (no writes): the hidden ones never
+ *    reach the root search; the survivors' nearest hit depth goes to nearest_tex.
+ * 3. tubes_nearest_depth: full-screen, depth := the nearest hit depth (ALWAYS).
+ * 4. tubes_shade: boxes with early tests GEQUAL against it; the nearest hit shades. */
+static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const sl_params *params,
+                                     const sl_line_style *style, sl_render_stats *stats, sl_err *err)
+{
+    sl_status st = ensure_nearest_image(s, view->width, view->height, err);
+    if (st != SL_OK)
+        return st;
+    const GLuint zero = 0;
+    glClearTexImage(s->nearest_tex, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+
+    glUseProgram(s->program_prepass);
+    glUniform1f(glGetUniformLocation(s->program_prepass, "u_radius"), style->radius);
+    glUniform1f(glGetUniformLocation(s->program_prepass, "u_radius_scale"), style->radius_scale);
+    glUniform1i(glGetUniformLocation(s->program_prepass, "u_data_radii"), s->nodes.has_radii);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->node_vbo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->ibo);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glBindVertexArray(s->vao); /* core profile needs a VAO bound; the pre-pass reads no attribute */
+    glDrawArrays(GL_POINTS, 0, (GLsizei)(3 * s->nodes.segment_count));
+    glBindVertexArray(0);
+    glDisable(GL_PROGRAM_POINT_SIZE);
+
+    set_uniforms(s->program_depth, style, params, s->nodes.has_radii);
+    glBindImageTexture(0, s->nearest_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glDepthMask(GL_FALSE);
+    draw_boxes(s, stats);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    glUseProgram(s->program_nearest);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glBindVertexArray(s->vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+
+    set_uniforms(s->program_shade, style, params, s->nodes.has_radii);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_GEQUAL);
+    glDepthMask(GL_FALSE);
+    draw_boxes(s, stats); /* the same triangles as pass 2: primitives counts one pass */
+    glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_GREATER);
+    return SL_OK;
+}
+
 static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                               sl_render_stats *stats, sl_err *err)
 {
@@ -194,30 +320,25 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
         s->attribute_loaded = style.attribute;
     }
     sl_camera_ubo_update(&s->camera_ubo, view);
-    GLuint program = sl_params_bool(params, "silhouette_only") ? s->program_silhouette : s->program;
-    set_uniforms(program, &style, params, s->nodes.has_radii);
     glBindTextureUnit(0, s->colormap_tex);
+    stats->culled = 0.0;
+    int silhouette_only = sl_params_bool(params, "silhouette_only");
+    if (!silhouette_only && sl_params_bool(params, "occlusion_prepass") && s->nodes.segment_count > 0)
+        return render_with_prepass(s, view, params, &style, stats, err);
+    set_uniforms(silhouette_only ? s->program_silhouette : s->program, &style, params, s->nodes.has_radii);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE); /* the geometry shader emits only faces towards the eye */
-    glBindVertexArray(s->vao);
-    glBeginQuery(GL_PRIMITIVES_GENERATED, s->query);
-    glDrawElements(GL_LINES, (GLsizei)(2 * s->nodes.segment_count), GL_UNSIGNED_INT, NULL);
-    glEndQuery(GL_PRIMITIVES_GENERATED);
-    glBindVertexArray(0);
-    GLuint triangles = 0;
-    glGetQueryObjectuiv(s->query, GL_QUERY_RESULT, &triangles);
-    stats->primitives = (double)triangles;                       /* triangles rasterized (2 per face) */
-    stats->culled = 0.0;
+    draw_boxes(s, stats);
     return SL_OK;
 }
 
 static size_t tubes_gpu_bytes(const void *opaque)
 {
     const tubes_state *s = opaque;
-    return s ? s->gpu_bytes : 0;
+    return s ? s->gpu_bytes + (size_t)s->nearest_w * (size_t)s->nearest_h * 4u : 0;
 }
 
 static void tubes_prepare_stats(const void *opaque, sl_prepare_stats *out)

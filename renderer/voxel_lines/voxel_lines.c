@@ -401,7 +401,7 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     s->padding = padding_for((float)(style.radius / probe.h));
     st = build_and_upload(s, style.attribute, err);
     if (st == SL_OK)
-        st = sl_gl_program_create(&(sl_program_desc){.vertex = "voxel_lines/voxel_lines_fullscreen.vert.glsl",
+        st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
                                                      .fragment = "voxel_lines/voxel_lines.frag.glsl",
                                                      .label = "voxel_lines"},
                                   &s->program, err);

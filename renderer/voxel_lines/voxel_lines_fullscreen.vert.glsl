@@ -1,7 +1,0 @@
-// voxel_lines_fullscreen.vert.glsl — one triangle covering the viewport; the
-// ray caster runs per fragment (no vertex buffers: gl_VertexID 0..2).
-void main()
-{
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
