@@ -325,6 +325,11 @@ static void print_row(const char *dataset, const char *technique, const char *mo
         printf("| %s | %s | %s | not available: %s | | | | |\n", dataset, technique, mode, r->why);
         return;
     }
+    if (r->frames == 0) {
+        printf("| %s | %s | %s | none: no interactive frame arrived during the drag | 0.0 | - | %.0f | %.0f |\n",
+               dataset, technique, mode, r->still_after_ms, r->still_cost_ms);
+        return;
+    }
     char b1[16], used[96] = "";
     size_t n = 0;
     for (int i = 0; i < r->nwidths && n < sizeof used; i++) {
@@ -332,7 +337,7 @@ static void print_row(const char *dataset, const char *technique, const char *mo
         n += (size_t)snprintf(used + n, sizeof used - n, "%s%s", i ? ", " : "", scale_name(r->widths[i], w, b, sizeof b));
     }
     printf("| %s | %s | %s | %s (%dx%d; used %s) | %.1f | %.0f / %.0f | %.0f | %.0f |\n", dataset, technique, mode,
-           r->frames ? scale_name(r->last_w, w, b1, sizeof b1) : "-", r->last_w, r->last_h, r->frames ? used : "-",
+           scale_name(r->last_w, w, b1, sizeof b1), r->last_w, r->last_h, used,
            r->fps, acc_pct(&r->latency, 50), acc_pct(&r->latency, 95), r->still_after_ms, r->still_cost_ms);
 }
 
