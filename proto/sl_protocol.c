@@ -308,6 +308,8 @@ cJSON *sl_msg_stream_json(const sl_stream_settings *s)
 {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "interactive_scale", s->interactive_scale);
+    cJSON_AddBoolToObject(o, "interactive_adaptive", s->interactive_adaptive);
+    cJSON_AddNumberToObject(o, "interactive_budget_ms", s->interactive_budget_ms);
     cJSON_AddNumberToObject(o, "interactive_quality", s->interactive_quality);
     cJSON_AddStringToObject(o, "interactive_subsampling", s->interactive_420 ? "420" : "444");
     cJSON_AddNumberToObject(o, "still_quality", s->still_quality);
@@ -335,10 +337,17 @@ sl_status sl_msg_stream_apply(sl_stream_settings *out, const cJSON *patch, char 
             *(k[0] == 'i' ? &s.interactive_420 : &s.still_420) = v;
             continue;
         }
+        if (strcmp(k, "interactive_adaptive") == 0) {
+            if (!cJSON_IsBool(it))
+                return sl_err_set(err, SL_ERR_INVALID, "%s must be true or false", k);
+            s.interactive_adaptive = cJSON_IsTrue(it);
+            continue;
+        }
         double lo, hi;
         if (strcmp(k, "interactive_scale") == 0) { lo = 0.1; hi = 1.0; }
         else if (strcmp(k, "interactive_quality") == 0 || strcmp(k, "still_quality") == 0) { lo = 1; hi = 100; }
         else if (strcmp(k, "still_delay_ms") == 0) { lo = 0; hi = 10000; }
+        else if (strcmp(k, "interactive_budget_ms") == 0) { lo = 10; hi = 2000; }
         else
             return sl_err_set(err, SL_ERR_INVALID, "unknown stream setting \"%.48s\"", k);
         if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble) || it->valuedouble < lo || it->valuedouble > hi ||
@@ -348,6 +357,7 @@ sl_status sl_msg_stream_apply(sl_stream_settings *out, const cJSON *patch, char 
         if (strcmp(k, "interactive_scale") == 0) s.interactive_scale = it->valuedouble;
         else if (strcmp(k, "interactive_quality") == 0) s.interactive_quality = (int)it->valuedouble;
         else if (strcmp(k, "still_quality") == 0) s.still_quality = (int)it->valuedouble;
+        else if (strcmp(k, "interactive_budget_ms") == 0) s.interactive_budget_ms = (int)it->valuedouble;
         else s.still_delay_ms = (int)it->valuedouble;
     }
     field[0] = '\0';

@@ -118,9 +118,15 @@ const char *sl_camera_phase_name(sl_camera_phase phase);
 /* {"type":"error","code":code,"message":message,"field":field}; field may be NULL or "". */
 char *sl_msg_error_text(const char *code, const char *message, const char *field);
 
-/* A session's stream settings (the `stream` object of `set` and state). */
+/* A session's stream settings (the `stream` object of `set` and state).
+ * While dragging, the server picks the scale: with interactive_adaptive the
+ * largest step of interactive_scale x {1, 1/2, 1/4, 1/8} whose predicted
+ * frame time (render + readback + encode) fits interactive_budget_ms;
+ * without it always interactive_scale. Still frames are full size. */
 typedef struct sl_stream_settings {
-    double interactive_scale;      /* 0.5: half size while dragging, 0.1..1 */
+    double interactive_scale;      /* 1: the largest scale while dragging, 0.1..1 */
+    int interactive_adaptive;      /* 1: pick a smaller step when frames are slow; 0: fixed scale */
+    int interactive_budget_ms;     /* 100 (10 fps), 10..2000: frame time the adaptive scale aims under */
     int interactive_quality;       /* 60, 1..100 */
     int interactive_420;           /* 1 */
     int still_quality;             /* 92, 1..100 */
@@ -128,7 +134,8 @@ typedef struct sl_stream_settings {
     int still_delay_ms;            /* 200, 0..10000 */
 } sl_stream_settings;
 
-#define SL_STREAM_DEFAULTS ((sl_stream_settings){.interactive_scale = 0.5, .interactive_quality = 60, \
+#define SL_STREAM_DEFAULTS ((sl_stream_settings){.interactive_scale = 1.0, .interactive_adaptive = 1, \
+                                                 .interactive_budget_ms = 100, .interactive_quality = 60, \
                                                  .interactive_420 = 1, .still_quality = 92, .still_420 = 0, \
                                                  .still_delay_ms = 200})
 

@@ -4,6 +4,7 @@
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
  *                    [--max-sessions N] [--grace S] [--egl-device D]
  *                    [--default-dataset NAME] [--hello-timeout S]
+ *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]   (tests only)
  *   sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
  *                    | remove NAME | scan DIR | add-builtins
  * (options may also follow the subcommand).
@@ -48,6 +49,9 @@ static void usage(FILE *f)
             "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
             "                        [--allow-origin URL]... [--max-clients N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--egl-device software|INDEX] [--default-dataset NAME] [--hello-timeout S]\n"
+            "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]\n"
+            "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
+            "                        frame's render, so a scene is slow in a known way)\n"
             "       sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list\n"
             "                        | remove NAME | scan DIR | add-builtins\n"
             "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n");
@@ -203,6 +207,14 @@ int main(int argc, char **argv)
             ok = parse_int(v, 0, 86400, &cfg.grace_s), i++;
         } else if (strcmp(a, "--hello-timeout") == 0 && v) {
             ok = parse_int(v, 1, 3600, &cfg.hello_timeout_s), i++;
+        } else if (strcmp(a, "--test-frame-delay-ms") == 0 && v) {
+            int ms = 0;
+            ok = parse_int(v, 0, 10000, &ms), i++;
+            cfg.test_frame_delay_ms = ms;
+        } else if (strcmp(a, "--test-frame-fixed-ms") == 0 && v) {
+            int ms = 0;
+            ok = parse_int(v, 0, 10000, &ms), i++;
+            cfg.test_frame_fixed_ms = ms;
         } else if (strcmp(a, "--default-dataset") == 0 && v) {
             cfg.default_dataset = v, i++;
         } else if (strcmp(a, "--egl-device") == 0 && v) {

@@ -10,7 +10,8 @@
  * service thread with lws_cancel_service. State that changed meanwhile is
  * simply rendered next time: the newest state wins, nothing is queued.
  * Interactive frames (camera phase start/move/end younger than
- * still_delay_ms) render at interactive_scale and JPEG quality; once the
+ * still_delay_ms) render at the scale interactive_scale.c picks from the
+ * session's measured frame costs, at the interactive JPEG quality; once the
  * delay passes a full-size still frame follows. Sessions are picked round
  * robin so one busy session cannot starve another. Sessions on the same
  * dataset share one loaded copy (dataset_cache.c). Never touches a socket.
@@ -89,9 +90,35 @@ static sl_status ensure_rgba(render_ctx *ctx, int w, int h, sl_err *err)
     return SL_OK;
 }
 
-/* Loads the dataset when its source changed, selects the technique and renders. */
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+/* What the interactive scale's estimates depend on besides the camera:
+ * dataset, technique, parameter values and image size. */
+static uint64_t scene_key(const sl_session_state *st)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    h = fnv1a(h, st->dataset_source, strlen(st->dataset_source) + 1);
+    h = fnv1a(h, st->technique, strlen(st->technique) + 1);
+    h = fnv1a(h, st->params.value, sizeof st->params.value[0] * (size_t)st->params.count);
+    h = fnv1a(h, &st->width, sizeof st->width);
+    return fnv1a(h, &st->height, sizeof st->height);
+}
+
+/* Loads the dataset when its source changed, selects the technique and
+ * renders at scale (1 = the session's size) with interactive or still
+ * quality. *render_ms is the time of the render call, *prepare_ms the part
+ * of it a technique prepare took. */
 static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
-                              int *w_out, int *h_out, double *render_ms, sl_err *err)
+                              double scale, int *w_out, int *h_out, double *render_ms, double *prepare_ms,
+                              sl_err *err)
 {
     sl_status rc;
     if (!s->pipeline && (rc = sl_pipeline_create(ctx->gpu, &s->pipeline, err)) != SL_OK)
@@ -143,9 +170,9 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
     if (is_orbit && (rc = sl_camera_from_orbit(&orbit, ds->bounds_min, ds->bounds_max, &view.camera, err)))
         return rc;
     int w = st->width, h = st->height;
-    if (interactive) {
-        w = (int)lround(w * st->stream.interactive_scale);
-        h = (int)lround(h * st->stream.interactive_scale);
+    if (scale < 1) {
+        w = (int)lround(w * scale);
+        h = (int)lround(h * scale);
         w = w < 1 ? 1 : w;
         h = h < 1 ? 1 : h;
     }
@@ -164,7 +191,8 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return rc;
     *w_out = w;
     *h_out = h;
-    *render_ms = sl_now_ms() - t0; /* completed by the caller's readback */
+    *render_ms = sl_now_ms() - t0;
+    *prepare_ms = stats.prepare_ms;
     return SL_OK;
 }
 
@@ -179,25 +207,45 @@ static void report_error(sl_server *srv, sl_session *s, const sl_session_state *
     pthread_mutex_unlock(&srv->lock);
 }
 
+/* --test-frame-delay-ms, --test-frame-fixed-ms: a render cost proportional
+ * to the frame's pixels, and one that is not. */
+static void test_delay(const sl_server *srv, const sl_session_state *st, int w, int h)
+{
+    double ms = srv->cfg.test_frame_delay_ms * ((double)w * h) / ((double)st->width * st->height) +
+                srv->cfg.test_frame_fixed_ms;
+    if (ms <= 0)
+        return;
+    struct timespec ts = {.tv_sec = (time_t)(ms / 1000.0), .tv_nsec = (long)(fmod(ms, 1000.0) * 1e6)};
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+        ;
+}
+
 static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive)
 {
     sl_err err = {0};
-    int w = 0, h = 0;
-    double render_ms = 0, encode_ms = 0;
+    int w = 0, h = 0, step = 0;
+    double render_ms = 0, prepare_ms = 0, encode_ms = 0;
     double t0 = sl_now_ms();
     sl_frame_buf *f = NULL;
-    if (render_state(ctx, s, st, interactive, &w, &h, &render_ms, &err) != SL_OK) {
+    sl_iscale_sync(&s->iscale, scene_key(st), st->stream.interactive_scale);
+    double scale = interactive ? sl_iscale_choose(&s->iscale, &st->stream, &step) : 1.0;
+    if (render_state(ctx, s, st, interactive, scale, &w, &h, &render_ms, &prepare_ms, &err) != SL_OK) {
         report_error(ctx->srv, s, st, &err);
         return;
     }
+    double t_read = sl_now_ms();
     sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 0);
-    render_ms = sl_now_ms() - t0;
+    test_delay(ctx->srv, st, w, h);
+    double t_done = sl_now_ms();
+    double cost_ms = render_ms - prepare_ms + (t_done - t_read);
+    render_ms = t_done - t0;
     int quality = interactive ? st->stream.interactive_quality : st->stream.still_quality;
     int sub420 = interactive ? st->stream.interactive_420 : st->stream.still_420;
     if (sl_encoder_jpeg(ctx->enc, ctx->rgba, w, h, quality, sub420, &f, &encode_ms, &err) != SL_OK) {
         report_error(ctx->srv, s, st, &err);
         return;
     }
+    sl_iscale_record(&s->iscale, interactive, step, cost_ms + encode_ms);
     sl_server *srv = ctx->srv;
     pthread_mutex_lock(&srv->lock);
     f->header.frame_id = ++s->next_frame_id;
@@ -220,10 +268,10 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
 {
     sl_err err = {0};
     int w = 0, h = 0;
-    double render_ms = 0, encode_ms = 0;
+    double render_ms = 0, prepare_ms = 0, encode_ms = 0;
     sl_frame_buf *f = NULL;
     sl_server *srv = ctx->srv;
-    if (render_state(ctx, s, st, 0, &w, &h, &render_ms, &err) == SL_OK) {
+    if (render_state(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &prepare_ms, &err) == SL_OK) {
         sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 1);
         if (sl_encoder_png(ctx->rgba, w, h, &f, &encode_ms, &err) == SL_OK) {
             f->header.state_version = st->version;

@@ -5,6 +5,7 @@
  *   session.c  sessions, clients, control, grace period, message handling
  *              (service thread)
  *   render.c   the render thread: owns sl_gpu and one sl_pipeline per session
+ *   interactive_scale.c  the adaptive scale of interactive frames (render thread)
  *   dataset_cache.c  loaded datasets shared by sessions (render thread)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
@@ -67,6 +68,8 @@ typedef struct sl_server_config {
     int hello_timeout_s;           /* default 10: seconds from upgrade to hello */
     const char *egl_device;        /* NULL: auto */
     const char *default_dataset;   /* NULL: the first catalog dataset the first technique accepts */
+    double test_frame_delay_ms;    /* tests only: sleep this x (frame pixels / session pixels) per frame */
+    double test_frame_fixed_ms;    /* tests only: and this, whatever the size (a vertex-bound render) */
 } sl_server_config;
 
 /* ---- frames (encoder.c) ---- */
@@ -116,6 +119,26 @@ typedef struct sl_session_state {
     float background[4];
     sl_stream_settings stream;
 } sl_session_state;
+
+/* interactive_scale.c (render thread only): per session, the cost of
+ * interactive frames at each step of the ladder top x {1, 1/2, 1/4, 1/8}. */
+#define SL_ISCALE_STEPS 4
+typedef struct sl_iscale {
+    int valid;
+    uint64_t scene_key;               /* what the estimates were measured on */
+    double top;                       /* interactive_scale: step 0 */
+    double ema_ms[SL_ISCALE_STEPS];   /* moving average of a step's frame cost, 0 = unknown */
+    double still_ms;                  /* cost of the last full-size still, 0 = unknown */
+    int step;                         /* the step in use */
+    int frames_at_step;               /* interactive frames measured since it was chosen */
+} sl_iscale;
+/* Starts afresh when scene_key (dataset, technique, params, size) or top changed. */
+void sl_iscale_sync(sl_iscale *a, uint64_t scene_key, double top);
+/* The scale of the next interactive frame (top when st is not adaptive); *step its ladder index. */
+double sl_iscale_choose(sl_iscale *a, const sl_stream_settings *st, int *step);
+/* A frame's cost (render + readback + encode ms, no load or prepare): an
+ * interactive frame at ladder step `step`, or a full-size still. */
+void sl_iscale_record(sl_iscale *a, int interactive, int step, double cost_ms);
 
 typedef struct sl_client sl_client;
 typedef struct sl_session sl_session;
@@ -172,6 +195,7 @@ struct sl_session {
     /* [render] */
     sl_pipeline *pipeline;
     char loaded_source[SL_SOURCE_MAX];
+    sl_iscale iscale;                        /* interactive scale estimates */
 };
 
 /* ---- metrics (http.c) ---- */

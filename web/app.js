@@ -1,5 +1,6 @@
 // app.js — the Sightline page: connects (protocol.js), draws frames on the
-// canvas with createImageBitmap, acks them, wires camera input (camera.js),
+// canvas with createImageBitmap (interactive frames, smaller, stretched to the
+// canvas), acks them, wires camera input (camera.js),
 // schema-generated parameter controls (controls.js), dataset/technique
 // pickers, views, snapshots, sharing, control requests and the status line.
 // The session id and token live in the URL fragment (#session=..&token=..),
@@ -141,6 +142,16 @@ function updateShareLink() {
   $('share-link').value = url.toString();
 }
 
+// The scale an interactive frame used (the server picks it, proto/PROTOCOL.md):
+// its width over the session's, as 1/2, 1/4 ... when it is one of those.
+function scaleLabel(width) {
+  const full = app.state?.width;
+  if (!full) return '';
+  const s = width / full;
+  const k = Math.round(Math.log2(1 / s));
+  return Math.abs(s * 2 ** k - 1) < 0.02 ? (k ? `1/${2 ** k}` : '1') : s.toFixed(2);
+}
+
 function updateStatus() {
   const f = app.lastFrame;
   const now = performance.now();
@@ -150,7 +161,7 @@ function updateStatus() {
   if (f) {
     parts.push(`${f.width}×${f.height} ${(f.bytes / 1024).toFixed(1)} KiB`);
     parts.push(`render ${f.renderMs.toFixed(1)} ms`, `encode ${f.encodeMs.toFixed(1)} ms`);
-    parts.push(f.interactive ? 'interactive' : 'still');
+    parts.push(f.interactive ? `interactive ${scaleLabel(f.width)}` : 'still');
     parts.push(`frame ${f.frameId}`);
   }
   $('status').textContent = parts.join(' · ');

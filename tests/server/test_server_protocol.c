@@ -3,8 +3,8 @@
  * Starts a private server (sl_server_harness.h) on a free loopback port and
  * checks, each with assertions that fail on a wrong server: hello/welcome;
  * frames arrive, carry a valid header and decode to the session size; a
- * camera change gives a different image; dragging gives half-size
- * interactive frames then a full-size still; malformed JSON, unknown type,
+ * camera change gives a different image; dragging at the fixed half scale
+ * gives half-size interactive frames then a full-size still; malformed JSON, unknown type,
  * unknown and out-of-range parameters each give an `error` and the
  * connection keeps working; oversize messages close only that connection
  * (1008); a wrong token is refused; two clients of one session see each
@@ -294,9 +294,12 @@ int main(void)
     double d = mean_diff(&first, &second);
     SL_CHECK_MSG(d > 1.0, "mean abs difference after a camera change %.3f", d);
 
-    /* --- dragging: half-size interactive frames, then a full-size still once the
-     *     session's still_delay_ms (set to 1500 here, a stream setting) has passed --- */
-    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"stream\":{\"still_delay_ms\":1500}}") == 0);
+    /* --- dragging at a fixed scale (adaptive off, interactive_scale 0.5): half-size
+     *     interactive frames, then a full-size still once the session's
+     *     still_delay_ms (set to 1500 here, a stream setting) has passed;
+     *     test_server_adaptive covers the adaptive scale --- */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"stream\":{\"still_delay_ms\":1500,\"interactive_adaptive\":false,"
+                              "\"interactive_scale\":0.5}}") == 0);
     cJSON *sp = tclient_wait_type(&a, "state", T);
     const cJSON *sd = cJSON_GetObjectItemCaseSensitive(
         cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(sp, "patch"), "stream"), "still_delay_ms");

@@ -2,7 +2,8 @@
  *
  * Every message type parses with its fields; every kind of bad input gives
  * SL_ERR_INVALID with the documented code and offending field and leaves the
- * message zeroed; the frame header round-trips every field bit-exactly and
+ * message zeroed; stream settings patch all or nothing, naming the bad key;
+ * the frame header round-trips every field bit-exactly and
  * rejects short buffers, a wrong magic, an unknown kind and a payload size
  * that disagrees with the message. No server, no GL.
  */
@@ -104,6 +105,30 @@ int main(void)
     SL_CHECK(ej && strcmp(cJSON_GetObjectItem(ej, "field")->valuestring, "params.x") == 0);
     cJSON_Delete(ej);
     free(e);
+
+    /* stream settings: defaults, a patch, and all-or-nothing failures naming the key */
+    sl_stream_settings ss = SL_STREAM_DEFAULTS;
+    SL_CHECK(ss.interactive_scale == 1.0 && ss.interactive_adaptive == 1 && ss.interactive_budget_ms == 100);
+    cJSON *sp = cJSON_Parse("{\"interactive_adaptive\":false,\"interactive_budget_ms\":250,\"interactive_scale\":0.5}");
+    SL_CHECK(sl_msg_stream_apply(&ss, sp, field, &err) == SL_OK);
+    SL_CHECK(!ss.interactive_adaptive && ss.interactive_budget_ms == 250 && ss.interactive_scale == 0.5);
+    cJSON_Delete(sp);
+    const char *bad_stream[][2] = {{"{\"interactive_budget_ms\":9}", "stream.interactive_budget_ms"},
+                                   {"{\"interactive_budget_ms\":100.5}", "stream.interactive_budget_ms"},
+                                   {"{\"interactive_adaptive\":\"yes\"}", "stream.interactive_adaptive"},
+                                   {"{\"interactive_budget_ms\":50,\"interactive_adaptive\":0}", "stream.interactive_adaptive"}};
+    for (size_t i = 0; i < sizeof bad_stream / sizeof bad_stream[0]; i++) {
+        sl_stream_settings before = ss;
+        sp = cJSON_Parse(bad_stream[i][0]);
+        SL_CHECK(sl_msg_stream_apply(&ss, sp, field, &err) == SL_ERR_INVALID);
+        SL_CHECK_MSG(strcmp(field, bad_stream[i][1]) == 0, "%s: field %s", bad_stream[i][0], field);
+        SL_CHECK(memcmp(&before, &ss, sizeof ss) == 0);
+        cJSON_Delete(sp);
+    }
+    cJSON *sj = sl_msg_stream_json(&ss);
+    SL_CHECK(cJSON_IsFalse(cJSON_GetObjectItem(sj, "interactive_adaptive")));
+    SL_CHECK(cJSON_GetObjectItem(sj, "interactive_budget_ms")->valueint == 250);
+    cJSON_Delete(sj);
 
     /* frame header */
     sl_frame_header h = {.kind = SL_FRAME_JPEG, .flags = SL_FRAME_FLAG_INTERACTIVE, .frame_id = 0xdeadbeef,
