@@ -33,15 +33,16 @@ static const line_set sets[] = {{"thin", 0.004, 0.006}, {"thick", 0.04, 0.06}};
 
 typedef struct row {
     const char *technique, *label;
-    const char *param;       /* one parameter that differs from the defaults, or NULL */
-    double value;
+    const char *param;       /* one enum parameter that differs from the defaults, or NULL */
+    const char *choice;
 } row;
 
 static const row rows[] = {
-    {"tubes", "tubes", NULL, 0},
-    {"tubes", "tubes, one pass (paper)", "occlusion_prepass", 0},
-    {"tubes_mesh", "tubes_mesh (12 sides)", NULL, 0},
-    {"voxel_lines", "voxel_lines opaque", NULL, 0},
+    {"tubes", "tubes (occlusion pre-pass auto)", NULL, NULL},
+    {"tubes", "tubes, pre-pass on", "occlusion_prepass", "on"},
+    {"tubes", "tubes, one pass (paper)", "occlusion_prepass", "off"},
+    {"tubes_mesh", "tubes_mesh (12 sides)", NULL, NULL},
+    {"voxel_lines", "voxel_lines opaque", NULL, NULL},
 };
 #define ROW_COUNT ((int)(sizeof rows / sizeof rows[0]))
 
@@ -63,7 +64,7 @@ static sl_status params_for(const sl_technique *t, const row *r, const sl_datase
     if (st == SL_OK)
         st = sl_bench_set(p, "radius", 0.5 * (set->rmin + set->rmax), err);
     if (st == SL_OK && r->param)
-        st = sl_bench_set(p, r->param, r->value, err);
+        st = sl_bench_set_choice(p, r->param, r->choice, err);
     return st;
 }
 

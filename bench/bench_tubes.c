@@ -100,7 +100,7 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
     sl_params mp0;
     sl_params_init(&mp0, mesh->params, mesh->param_count);
     printf("\n## Speed (%dx%d, %d orbit frames after a warm-up; wall ms to glFinish after the readback)\n\n"
-           "tubes: with its occlusion pre-pass (the default); one pass: occlusion_prepass off, the paper's; silhouette "
+           "tubes: defaults (occlusion_prepass auto); one pass: occlusion_prepass off, the paper's; silhouette "
            "only: boxes with a fragment shader that discards (vertex, geometry and raster cost). Peers read the same "
            "lines (legacy VTK) and cameras: VTK (Debian python3-vtk9): vtkTubeFilter (%d sides, %s, as tubes_mesh) + vtkPolyDataMapper on "
            "the same GL under xvfb-run; Embree round Hermite curves on the CPU, one thread per core. In brackets: peer "
@@ -157,7 +157,7 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
             sl_params_init(&op, tubes->params, tubes->param_count);
             sl_params_init(&sp, tubes->params, tubes->param_count);
             sl_params_init(&mp, mesh->params, mesh->param_count);
-            sl_bench_set(&op, "occlusion_prepass", 0, err);
+            sl_bench_set_choice(&op, "occlusion_prepass", "off", err);
             sl_bench_set(&sp, "silhouette_only", 1, err);
             sl_bench_timing rt, ro, rs, rm;
             if ((st = sl_bench_time_frames(p, tubes, &tp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rt,

@@ -65,6 +65,43 @@ foreach(name stress_zero_length stress_zero_tangents stress_collinear stress_rad
              stress_offset stress_grazing stress_inside stress_near_plane bifurcation sharp_corner varying_radius)
   tubes_render_test(accuracy.${name} tubes-check --scene ${TUBES_DIR}/${name}.json)
 endforeach()
+# The occlusion pre-pass (occlusion_prepass; auto decides by depth complexity,
+# so small test scenes would mostly run without it): forced on for the random,
+# close, thin, stress and golden scenes and a dense one where spheres hide most
+# boxes (radius x 4), forced off for a few, each against the same reference.
+foreach(name stress_zero_length stress_zero_tangents stress_collinear stress_radius_zero_end stress_big_radius
+             stress_offset stress_grazing stress_inside stress_near_plane bifurcation sharp_corner varying_radius)
+  tubes_render_test(accuracy.prepass_on.${name} tubes-check --scene ${TUBES_DIR}/${name}.json
+    --set params.occlusion_prepass=on)
+endforeach()
+tubes_render_test(accuracy.prepass_on.random_1
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 1 --set params.occlusion_prepass=on)
+tubes_render_test(accuracy.prepass_on.random_close
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 6 --set camera.orbit.distance=0.6
+  --set params.occlusion_prepass=on)
+tubes_render_test(accuracy.prepass_on.random_dense
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 10 --set params.radius_scale=4
+  --set params.occlusion_prepass=on)
+tubes_render_test(accuracy.prepass_on.random_thin_close
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 9 --set params.radius_scale=0.15
+  --set camera.orbit.distance=0.5 --set params.occlusion_prepass=on)
+foreach(name stress_inside stress_near_plane)
+  tubes_render_test(accuracy.prepass_off.${name} tubes-check --scene ${TUBES_DIR}/${name}.json
+    --set params.occlusion_prepass=off)
+endforeach()
+tubes_render_test(accuracy.prepass_off.random_dense
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 10 --set params.radius_scale=4
+  --set params.occlusion_prepass=off)
+# The same frame with the pre-pass on and off: identical depth everywhere (the
+# pre-pass only skips boxes that cannot win) and the same colours up to pixels
+# where two sub-segments hit within the shade pass's few-ulp tie rule.
+tubes_render_test(prepass.same_frame_dense
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_on.png|--depth|${TUBES_OUT}/dense_on.pfm|--samples|1|--set|params.occlusion_prepass=on"
+  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_off.png|--depth|${TUBES_OUT}/dense_off.pfm|--samples|1|--set|params.occlusion_prepass=off"
+  "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.pfm|${TUBES_OUT}/dense_off.pfm|--max-abs|0"
+  "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.png|${TUBES_OUT}/dense_off.png|--max-bad-pct|0.1"
+  -P ${TUBES_DIR}/run_steps.cmake)
 # The root methods at the default iterations on the thin-tube scene (the
 # default method is covered by every test above).
 foreach(method bisection illinois newton)

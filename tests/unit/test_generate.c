@@ -129,6 +129,7 @@ static void test_determinism(void)
         {"{\"generator\":\"bundle\",\"lines\":40,\"points\":50}", "{\"generator\":\"bundle\",\"lines\":40,\"points\":50,\"seed\":2}"},
         {"{\"generator\":\"furball\",\"segments\":5000}", "{\"generator\":\"furball\",\"segments\":5000,\"seed\":2}"},
         {"{\"generator\":\"hotroom\",\"lines\":500}", "{\"generator\":\"hotroom\",\"lines\":500,\"seed\":2}"},
+        {"{\"generator\":\"random_walk\",\"lines\":40,\"points\":50}", "{\"generator\":\"random_walk\",\"lines\":40,\"points\":50,\"seed\":2}"},
         {"{\"generator\":\"marschner_lobb\",\"size\":16,\"noise\":0.1}", "{\"generator\":\"marschner_lobb\",\"size\":16,\"noise\":0.1,\"seed\":2}"},
         {"{\"generator\":\"torus\",\"size\":16,\"noise\":0.1}", "{\"generator\":\"torus\",\"size\":16,\"noise\":0.1,\"seed\":2}"},
         {"{\"generator\":\"head\",\"size\":16,\"noise\":0.5}", "{\"generator\":\"head\",\"size\":16,\"noise\":0.5,\"seed\":2}"},
@@ -163,8 +164,8 @@ static void test_determinism(void)
 /* Lines families with lines/points keys: exact counts, every line `points` long. */
 static void test_counts(void)
 {
-    static const char *names[] = {"tornado", "abc", "bundle"};
-    for (int f = 0; f < 3; f++) {
+    static const char *names[] = {"tornado", "abc", "bundle", "random_walk"};
+    for (int f = 0; f < 4; f++) {
         char json[256];
         snprintf(json, sizeof json, "{\"generator\":\"%s\",\"lines\":37,\"points\":23,\"seed\":5}", names[f]);
         sl_dataset *ds = gen(json);
@@ -205,6 +206,46 @@ static size_t segment_count(const sl_lines *l)
     for (size_t k = 0; k < l->line_count; k++)
         s += l->line_offsets[k + 1] - l->line_offsets[k] - 1;
     return s;
+}
+
+/* random_walk: inside the box (mirrored steps), segment lengths of the
+ * benchmark's description, radii in their range, a reversed range refused. */
+static void test_random_walk(void)
+{
+    sl_dataset *ds = gen("{\"generator\":\"random_walk\",\"lines\":200,\"points\":200,\"half\":3,"
+                         "\"radius_min\":0.04,\"radius_max\":0.06,\"seed\":4}");
+    if (ds) {
+        const sl_lines *l = &ds->lines;
+        SL_CHECK(l->radii != NULL && l->line_count == 200 && l->vertex_count == 40000);
+        double sum = 0.0, inside = 0.0;
+        size_t segs = 0, short_or_long = 0;
+        for (size_t k = 0; k < l->line_count; k++)
+            for (uint32_t i = l->line_offsets[k]; i + 1 < l->line_offsets[k + 1]; i++) {
+                double a[3], b[3], d2 = 0.0;
+                world(ds, i, a);
+                world(ds, i + 1, b);
+                for (int c = 0; c < 3; c++)
+                    d2 += (b[c] - a[c]) * (b[c] - a[c]);
+                double len = sqrt(d2);
+                sum += len;
+                short_or_long += len < 0.005 || len > 0.1;
+                segs++;
+            }
+        for (size_t v = 0; v < l->vertex_count; v++) {
+            double p[3];
+            world(ds, v, p);
+            inside += fabs(p[0]) <= 3.0 + 1e-6 && fabs(p[1]) <= 3.0 + 1e-6 && fabs(p[2]) <= 3.0 + 1e-6;
+            SL_CHECK_MSG(l->radii[v] >= 0.04f - 1e-7f && l->radii[v] <= 0.06f + 1e-7f, "radius %g", l->radii[v]);
+        }
+        double mean = sum / (double)segs;
+        SL_CHECK_MSG(mean > 0.02 && mean < 0.04, "mean segment length %g, want about 0.03", mean);
+        SL_CHECK_MSG(short_or_long < segs / 20, "%zu of %zu segments outside [0.005, 0.1]", short_or_long, segs);
+        SL_CHECK_MSG(inside == (double)l->vertex_count, "%.0f of %zu vertices inside the box", inside, l->vertex_count);
+    }
+    sl_dataset_destroy(ds);
+    sl_dataset *bad = NULL;
+    SL_CHECK(sl_generate_json("{\"generator\":\"random_walk\",\"radius_min\":0.2,\"radius_max\":0.1}", &bad, NULL) ==
+                 SL_ERR_INVALID && !bad);
 }
 
 static void test_furball(void)
@@ -590,10 +631,11 @@ static void test_catalog(void)
 {
     int n = 0;
     const sl_generator_info *g = sl_generator_list(&n);
-    SL_CHECK(n == 8);
-    static const sl_gen_family *fams[] = {&sl_gen_tornado, &sl_gen_abc, &sl_gen_bundle, &sl_gen_furball,
-                                          &sl_gen_hotroom, &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head};
-    for (int i = 0; i < 8; i++) {
+    SL_CHECK(n == 9);
+    static const sl_gen_family *fams[] = {&sl_gen_tornado, &sl_gen_abc,           &sl_gen_bundle,
+                                          &sl_gen_furball, &sl_gen_hotroom,       &sl_gen_random_walk,
+                                          &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head};
+    for (int i = 0; i < 9; i++) {
         int listed = 0;
         for (int j = 0; j < n; j++)
             listed |= strcmp(g[j].name, fams[i]->name) == 0 && g[j].kind == fams[i]->kind;
@@ -874,6 +916,8 @@ static void test_fingerprints(void)
      {22u, 2022u, 0x4405a83ab945811eull, {{-37.133226229809225, -54.776307078579578, 2012.9445473989472}, {0, 0, 0}, {1264.8359995484352, 1852.9864606516282, 1264.8359995484352}, {0, 0, 0}}}},
     {"{\"generator\":\"hotroom\",\"lines\":200,\"seed\":3}",
      {200u, 686u, 0x3ed736e9b7c4939dull, {{3636.4620711244643, 5311.3955915481492, 3636.4620711244643}, {54.04782940261066, 79.797361513743056, 54.04782940261066}, {15807.136465698481, 23091.225588784735, 15807.136465698481}, {92.990609086977202, 138.91184507710312, 791.37388523835398}}}},
+    {"{\"generator\":\"random_walk\",\"lines\":12,\"points\":40,\"seed\":3}",
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{-273.75547290383838, -400.05450750638471, 2377.3196250933688}, {2.3986461558379233, 3.5046494975686069, 2.3986461558379233}, {0, 0, 0}, {0, 0, 0}}}},
     {"{\"generator\":\"marschner_lobb\",\"size\":12,\"noise\":0.1,\"seed\":3}",
      {1728u, 1u, 0xd143def6ecbf59cbull, {{861.74810269557929, 1258.0309063051918, 864.52593155986688}, {0.54545454545454497, 2.0979020979020984, 6.545454545454545}, {0, 0, 0}, {0, 0, 0}}}},
     {"{\"generator\":\"torus\",\"size\":12,\"noise\":0.1,\"seed\":3}",
@@ -887,6 +931,7 @@ static void test_fingerprints(void)
         "{\"generator\":\"bundle\",\"lines\":12,\"points\":40,\"seed\":3}",
         "{\"generator\":\"furball\",\"segments\":2000,\"seed\":3}",
         "{\"generator\":\"hotroom\",\"lines\":200,\"seed\":3}",
+        "{\"generator\":\"random_walk\",\"lines\":12,\"points\":40,\"seed\":3}",
         "{\"generator\":\"marschner_lobb\",\"size\":12,\"noise\":0.1,\"seed\":3}",
         "{\"generator\":\"torus\",\"size\":12,\"noise\":0.1,\"seed\":3}",
         "{\"generator\":\"head\",\"size\":12,\"noise\":0.5,\"seed\":3}",
@@ -940,6 +985,7 @@ int main(void)
     test_fingerprints();
     test_counts();
     test_furball();
+    test_random_walk();
     test_fields();
     test_random();
     test_tracer();
