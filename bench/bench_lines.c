@@ -2,19 +2,15 @@
  *
  *   bench-lines [--small | --size WxH] [--frames N] [--lines N] [--points N] [--only thin|thick] [--skip-peers]
  *
- * Data: the `random_walk` generator (lines x points, AR(1) steps about
- * 0.01-0.05 long in a +-3 box) at two radius ranges, thin (0.004-0.006) and
- * thick (0.04-0.06), written once per set as legacy VTK with the radius as a
- * point scalar. Our techniques load that very file through sl_load_file
- * (radius_attribute = its `radius` scalar; voxel_lines draws one radius, the
- * range's middle); VTK's tube filter (bench/vtk_tubes.py, same llvmpipe under
- * xvfb-run) and Embree 3 round Hermite curves (peer-embree-tubes, CPU, one
- * thread per core) read it too, with the same cameras: an eye circling the
- * origin at distance 8 (frame 0: eye (0, 0, 8)), fov 45, constant colour.
- * Prints per renderer the wall frame ms (median / min / max: render + readback
- * of the whole frame + glFinish), the GPU-timer ms, prepare, peak RSS and GPU
- * memory, and the ratios to VTK and to Embree (peer ms / ours: above 1 means
- * ours is faster). Checks nothing. Main thread = render thread.
+ * Data: `random_walk` (AR(1) steps about 0.01-0.05 long in a +-3 box), thin
+ * (radius 0.004-0.006) and thick (0.04-0.06), written once as legacy VTK with
+ * the radius as a point scalar; our techniques load that very file
+ * (radius_attribute = its `radius`; voxel_lines: one radius, the middle), VTK's
+ * tube filter (bench/vtk_tubes.py, same llvmpipe) and Embree round Hermite
+ * curves (peer-embree-tubes, CPU) read it too, with the same cameras: an eye
+ * circling the data at distance 8 (frame 0: eye (0, 0, 8)), fov 45, constant
+ * colour. Prints wall ms (median / min / max), GPU ms, prepare, peak RSS, GPU
+ * memory and the ratios peer / ours. Checks nothing. Main thread = render thread.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,6 +87,10 @@ static sl_status bench_set(sl_gpu *gpu, const line_set *set, int lines, int poin
     const sl_bench_view_spec view = {"circle", sl_bench_circle_camera, &circle};
     sl_bench_peer_files files;
     st = sl_bench_peer_files_write(generated, 1.0f, &view, 1, o, &files, err);
+    /* The file's coordinates are the generated world less its origin, and that
+     * is the loaded dataset's world: our circle is about the same point. */
+    const sl_vec3 shift = generated->origin;
+    const sl_bench_circle ours = {.target = {-shift.x, -shift.y, -shift.z}, .radius = 8.0, .fov_y_deg = 45.0};
     sl_dataset_destroy(generated);
     if (st != SL_OK)
         return st;
@@ -130,13 +130,13 @@ static sl_status bench_set(sl_gpu *gpu, const line_set *set, int lines, int poin
         if (!t)
             st = sl_err_set(err, SL_ERR_UNSUPPORTED, "%s is not registered", rows[r].technique);
         if (st == SL_OK && (st = params_for(t, &rows[r], ds, set, &params, err)) == SL_OK)
-            st = sl_bench_time_frames(p, t, &params, o, SL_QUALITY_STILL, sl_bench_circle_camera, &circle, &tm, err);
+            st = sl_bench_time_frames(p, t, &params, o, SL_QUALITY_STILL, sl_bench_circle_camera, &ours, &tm, err);
         if (st != SL_OK)
             break;
         char gpu_cell[32];
-        printf("| %s | %.1f | %.1f | %.1f | %s | %.0f | %.0f | %.1f |", rows[r].label, tm.median_ms, tm.min_ms,
+        printf("| %s | %.1f | %.1f | %.1f | %s | %.0f | %.0f%s | %.1f |", rows[r].label, tm.median_ms, tm.min_ms,
                tm.max_ms, sl_bench_gpu_cell(&tm, gpu_cell, sizeof gpu_cell), tm.prepare_ms, tm.peak_rss_mb,
-               tm.gpu_bytes / 1048576.0);
+               tm.peak_rss_since_start ? "*" : "", tm.gpu_bytes / 1048576.0);
         print_ratio(vtk.median_ms[0], tm.median_ms, vtk.ok);
         print_ratio(embree.median_ms[0], tm.median_ms, embree.ok);
         printf("\n");
@@ -177,11 +177,19 @@ int main(int argc, char **argv)
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(a, "--skip-peers") == 0) {
             skip_peers = 1;
-        } else if (strcmp(a, "--lines") == 0 && v && (lines = atoi(v)) >= 1 && lines <= 1000000) {
-            i++;
-        } else if (strcmp(a, "--points") == 0 && v && (points = atoi(v)) >= 2 && points <= 10000) {
+        } else if (strcmp(a, "--lines") == 0 || strcmp(a, "--points") == 0) {
+            int is_lines = a[2] == 'l';
+            if (!v || sl_bench_parse_int(v, is_lines ? 1 : 2, is_lines ? 1000000 : 10000, is_lines ? &lines : &points)) {
+                fprintf(stderr, "bench-lines: %s wants a count in [%d, %d]\n", a, is_lines ? 1 : 2,
+                        is_lines ? 1000000 : 10000);
+                return 1;
+            }
             i++;
         } else if (strcmp(a, "--only") == 0 && v) {
+            if (strcmp(v, "thin") != 0 && strcmp(v, "thick") != 0) {
+                fprintf(stderr, "bench-lines: --only wants thin or thick, not %s\n", v);
+                return 1;
+            }
             only = v;
             i++;
         } else {

@@ -157,10 +157,10 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
             sl_params_init(&op, tubes->params, tubes->param_count);
             sl_params_init(&sp, tubes->params, tubes->param_count);
             sl_params_init(&mp, mesh->params, mesh->param_count);
-            sl_bench_set_choice(&op, "occlusion_prepass", "off", err);
-            sl_bench_set(&sp, "silhouette_only", 1, err);
             sl_bench_timing rt, ro, rs, rm;
-            if ((st = sl_bench_time_frames(p, tubes, &tp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rt,
+            if ((st = sl_bench_set_choice(&op, "occlusion_prepass", "off", err)) != SL_OK ||
+                (st = sl_bench_set(&sp, "silhouette_only", 1, err)) != SL_OK ||
+                (st = sl_bench_time_frames(p, tubes, &tp, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &rt,
                                            err)) != SL_OK ||
                 (st = sl_bench_time_frames(p, tubes, &op, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbits[v], &ro,
                                            err)) != SL_OK ||
@@ -487,7 +487,16 @@ int main(int argc, char **argv)
         else if (strcmp(a, "--skip-error") == 0) o.skip_error = 1;
         else if (strcmp(a, "--skip-cubic") == 0) o.skip_cubic = 1;
         else if (strcmp(a, "--skip-peers") == 0) o.skip_peers = 1;
-        else if (strcmp(a, "--datasets") == 0 && i + 1 < argc) o.only = argv[++i];
+        else if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
+            o.only = argv[++i];
+            int known = 0;
+            for (int d = 0; d < DATASET_COUNT; d++)
+                known += strstr(o.only, datasets[d].name) != NULL;
+            if (!known) {
+                fprintf(stderr, "bench-tubes: --datasets names none of fibers,hotroom,bundle,brain,furball\n");
+                return 1;
+            }
+        }
         else {
             fprintf(stderr, "usage: bench-tubes %s [--datasets fibers,hotroom,bundle,brain,furball]\n"
                             "                   [--skip-perf] [--skip-error] [--skip-cubic] [--skip-peers]\n",

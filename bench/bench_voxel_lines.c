@@ -113,9 +113,14 @@ int main(int argc, char **argv)
         if (strcmp(a, "--no-table1") == 0) { o.table1 = 0; continue; }
         if (strcmp(a, "--no-table2") == 0) { o.table2 = 0; continue; }
         i++;
-        if (strcmp(a, "--scale") == 0) o.scale = atof(v);
-        else if (strcmp(a, "--grid") == 0) o.grid = atoi(v);
-        else if (strcmp(a, "--quant") == 0) o.quant = atoi(v);
+        char *end = NULL;
+        if (strcmp(a, "--scale") == 0) {
+            o.scale = strtod(v, &end);
+            if (end == v || *end)
+                o.scale = -1.0; /* refused below */
+        }
+        else if (strcmp(a, "--grid") == 0 && sl_bench_parse_int(v, 0, 512, &o.grid) == 0) {}
+        else if (strcmp(a, "--quant") == 0 && sl_bench_parse_int(v, 1, 256, &o.quant) == 0) {}
         else if (strcmp(a, "--only") == 0) o.only = v;
         else if (strcmp(a, "--table1-grids") == 0) {
             if (parse_settings(v, &o) != 0) {

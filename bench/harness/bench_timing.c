@@ -115,7 +115,7 @@ sl_status sl_bench_time_frames(sl_pipeline *p, const sl_technique *t, const sl_p
         free(rgba);
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for %dx%d frames", o->width, o->height);
     }
-    reset_peak_rss();
+    int reset = reset_peak_rss();
     for (int f = -1; f < o->frames && st == SL_OK; f++) {
         sl_view view = {.width = o->width, .height = o->height, .quality = quality, .origin = ds->origin,
                         .background = {0.1f, 0.1f, 0.12f, 1.0f}};
@@ -145,6 +145,7 @@ sl_status sl_bench_time_frames(sl_pipeline *p, const sl_technique *t, const sl_p
         out->max_ms = wall[o->frames - 1];
         out->gpu_ms = sl_bench_median(gpu, o->frames);
         out->peak_rss_mb = peak_rss_mb();
+        out->peak_rss_since_start = !reset;
     }
     free(wall);
     free(rgba);

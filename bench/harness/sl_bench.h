@@ -25,13 +25,15 @@
 typedef struct sl_bench_options {
     int width, height;   /* default 1280x720; --small 256x144; --size WxH */
     int frames;          /* timed frames of an orbit, after one warm-up; --frames N */
-    int small;           /* --small was given */
 } sl_bench_options;
 
 #define SL_BENCH_OPTIONS_HELP "[--small | --size WxH] [--frames N]"
 
 /* Defaults: 1280x720, `frames` timed frames (the program's own default). */
 void sl_bench_options_init(sl_bench_options *o, int frames);
+
+/* Parses a whole decimal integer in [lo, hi] into *out: 0, or -1 (nothing written). */
+int sl_bench_parse_int(const char *text, long lo, long hi, int *out);
 
 /* Reads argv[*i] (and its value) when it is a common option: returns 1 and
  * advances *i past it, 0 when it is not one (nothing changes), -1 on a bad
@@ -61,6 +63,7 @@ typedef struct sl_bench_timing {
     double gpu_ms;                     /* median GPU-timer ms (second column) */
     double prepare_ms;                 /* the warm-up's prepare (0 when none ran) */
     double peak_rss_mb;                /* the process' peak resident set during the run (VmHWM) */
+    int peak_rss_since_start;          /* 1: the peak could not be reset, it counts from process start */
     double primitives;                 /* as the technique reports, last frame */
     size_t gpu_bytes;                  /* GPU memory the technique holds */
 } sl_bench_timing;

@@ -22,12 +22,7 @@ struct sl_oit_node { uint color; float depth; uint next; };
 layout(std430, binding = 2) buffer sl_oit_nodes { sl_oit_node oit_nodes[]; };
 
 uniform uint u_capacity;
-uniform sampler2D u_colormap;
-uniform vec2 u_scalar_range;
-uniform int u_use_colormap;
-uniform vec3 u_color;
-uniform vec3 u_light_eye;
-uniform vec4 u_material;
+#include "gpu/glsl/line_style.glsl"
 uniform float u_opacity;
 uniform int u_opacity_ramp;
 

@@ -1,21 +1,15 @@
 /* tubes.c — technique `tubes`: raycast Hermite spline tubes (Russig, Salm, Gumhold,
  * "GPU-based Raycasting of Hermite Spline Tubes", 3.2).
  *
- * prepare turns the line set into Hermite nodes and segments (tubes_nodes.c)
- * and uploads them once: a node buffer, a colour-scalar buffer and a segment
- * index buffer. render is one indexed GL_LINES draw: tubes.geom.glsl splits
- * each segment into two quadratic Beziers and emits their oriented boxes,
- * tubes.frag.glsl finds the nearest sphere-sweep entry per pixel. A camera
- * move re-uploads nothing; radius, colour and root-search parameters are
- * uniforms (an attribute change re-fills the small scalar buffer; a
- * radius_attribute change re-prepares: radii live in the node buffer). An
- * attribute index the dataset lacks is an error (sl_line_style_check).
- * occlusion_prepass (beyond the paper; render_with_prepass; auto picks it
- * where tubes hide each other): an occluder depth pre-pass of spheres inside
- * the sweep lets early depth tests reject hidden boxes before their root
- * search — on llvmpipe a discard does not skip the rest of a shader, only a
- * fragment rejected before the shader skips all of it.
- * Does not do transparency or level of detail. Render thread only (GL).
+ * prepare builds Hermite nodes and segments (tubes_nodes.c) and uploads them
+ * once; render is one indexed GL_LINES draw whose geometry shader emits each
+ * quadratic sub-segment's oriented box and whose fragment shader finds the
+ * nearest sphere-sweep entry. A camera move re-uploads nothing (an attribute
+ * change refills the colour buffer; radius_attribute re-prepares). Beyond the
+ * paper, occlusion_prepass (render_with_prepass) draws spheres inside the
+ * sweep first so that early depth tests keep hidden boxes from the root search:
+ * on llvmpipe a discard skips nothing, a fragment rejected before the shader
+ * skips all of it. No transparency, no level of detail. Render thread (GL).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -30,14 +24,14 @@
 static const char *const root_methods[] = {"bisection", "illinois", "newton", NULL};
 static const char *const tangent_modes[] = {"auto", "catmull_rom", "data_exact", NULL};
 static const char *const prepass_modes[] = {"auto", "on", "off", NULL};
-enum { PREPASS_AUTO, PREPASS_ON, PREPASS_OFF };
+enum { SL_TUBES_PREPASS_AUTO, SL_TUBES_PREPASS_ON, SL_TUBES_PREPASS_OFF };
 
 /* auto: the pre-pass pays where tubes hide each other. Estimated depth
  * complexity = the tubes' projected area (2 r x length summed) over the
  * bounding sphere's disc; camera-independent for a view from outside. At
  * 1280x720 on llvmpipe (random_walk in a +-3 box): 0.7 lost (5.5 s vs 4.0
  * one pass), 2.1 won (8.9 vs 10.8), 4.2 won 3x, 7 won 4x. */
-#define TUBES_PREPASS_MIN_DEPTH_COMPLEXITY 1.2
+#define SL_TUBES_PREPASS_MIN_DEPTH_COMPLEXITY 1.2
 
 static const sl_param_def tubes_params[] = {
     SL_LINE_STYLE_PARAMS,
@@ -73,6 +67,7 @@ typedef struct tubes_state {
     int nearest_w, nearest_h;
     double length_sum, length_radius_sum; /* sum of segment chords; of chord x mean data radius (occlusion auto) */
     GLuint vao, node_vbo, color_vbo, ibo, colormap_tex, camera_ubo, query;
+    GLuint empty_vao;            /* no attributes: the pulling and full-screen passes */
     int colormap_loaded;         /* colormap index in colormap_tex, or -1 */
     int attribute_loaded;        /* attribute in color_vbo, or -2 */
     size_t gpu_bytes;
@@ -92,6 +87,7 @@ static void tubes_release(void *opaque)
     if (s->program_shade) glDeleteProgram(s->program_shade);
     if (s->nearest_tex) glDeleteTextures(1, &s->nearest_tex);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
+    if (s->empty_vao) glDeleteVertexArrays(1, &s->empty_vao);
     if (s->node_vbo) glDeleteBuffers(1, &s->node_vbo);
     if (s->color_vbo) glDeleteBuffers(1, &s->color_vbo);
     if (s->ibo) glDeleteBuffers(1, &s->ibo);
@@ -131,40 +127,22 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
         s->length_radius_sum += chord * 0.5 * fabs((double)a[3] + b[3]);
     }
     s->prep.preprocess_ms = sl_now_ms() - t_build;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
-                                                      .geometry = "tubes/tubes.geom.glsl",
-                                                      .fragment = "tubes/tubes.frag.glsl",
-                                                      .label = "tubes"},
-                                   &s->program, err)) != SL_OK)
-        goto fail;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
-                                                      .geometry = "tubes/tubes.geom.glsl",
-                                                      .fragment = "tubes/tubes_silhouette.frag.glsl",
-                                                      .label = "tubes_silhouette"},
-                                   &s->program_silhouette, err)) != SL_OK)
-        goto fail;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes_prepass.vert.glsl",
-                                                      .fragment = "tubes/tubes_prepass.frag.glsl",
-                                                      .label = "tubes_prepass"},
-                                   &s->program_prepass, err)) != SL_OK)
-        goto fail;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
-                                                      .geometry = "tubes/tubes.geom.glsl",
-                                                      .fragment = "tubes/tubes_depth.frag.glsl",
-                                                      .label = "tubes_depth"},
-                                   &s->program_depth, err)) != SL_OK)
-        goto fail;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
-                                                      .fragment = "tubes/tubes_nearest_depth.frag.glsl",
-                                                      .label = "tubes_nearest_depth"},
-                                   &s->program_nearest, err)) != SL_OK)
-        goto fail;
-    if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = "tubes/tubes.vert.glsl",
-                                                      .geometry = "tubes/tubes.geom.glsl",
-                                                      .fragment = "tubes/tubes_shade.frag.glsl",
-                                                      .label = "tubes_shade"},
-                                   &s->program_shade, err)) != SL_OK)
-        goto fail;
+    const struct { const char *label, *vertex, *fragment; GLuint *program; int boxes; } programs[] = {
+        {"tubes", "tubes/tubes.vert.glsl", "tubes/tubes.frag.glsl", &s->program, 1},
+        {"tubes_silhouette", "tubes/tubes.vert.glsl", "tubes/tubes_silhouette.frag.glsl", &s->program_silhouette, 1},
+        {"tubes_prepass", "tubes/tubes_prepass.vert.glsl", "tubes/tubes_prepass.frag.glsl", &s->program_prepass, 0},
+        {"tubes_depth", "tubes/tubes.vert.glsl", "tubes/tubes_depth.frag.glsl", &s->program_depth, 1},
+        {"tubes_nearest_depth", "gpu/glsl/fullscreen_triangle.vert.glsl", "tubes/tubes_nearest_depth.frag.glsl",
+         &s->program_nearest, 0},
+        {"tubes_shade", "tubes/tubes.vert.glsl", "tubes/tubes_shade.frag.glsl", &s->program_shade, 1},
+    };
+    for (size_t k = 0; k < sizeof programs / sizeof programs[0]; k++)
+        if ((st = sl_gl_program_create(&(sl_program_desc){.vertex = programs[k].vertex,
+                                                          .geometry = programs[k].boxes ? "tubes/tubes.geom.glsl" : NULL,
+                                                          .fragment = programs[k].fragment,
+                                                          .label = programs[k].label},
+                                       programs[k].program, err)) != SL_OK)
+            goto fail;
 
     double t_upload = sl_now_ms();
     size_t nn = s->nodes.node_count ? s->nodes.node_count : 1;
@@ -177,6 +155,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     glCreateBuffers(1, &s->ibo);
     glNamedBufferStorage(s->ibo, (GLsizeiptr)(ns * 2 * sizeof(uint32_t)),
                          s->nodes.segment_count ? s->nodes.segments : NULL, 0);
+    glCreateVertexArrays(1, &s->empty_vao);
     glCreateVertexArrays(1, &s->vao);
     glVertexArrayVertexBuffer(s->vao, 0, s->node_vbo, 0, SL_TUBES_NODE_FLOATS * sizeof(float));
     glVertexArrayVertexBuffer(s->vao, 1, s->color_vbo, 0, 2 * sizeof(float));
@@ -237,6 +216,8 @@ static sl_status ensure_nearest_image(tubes_state *s, int w, int h, sl_err *err)
     if (s->nearest_tex)
         glDeleteTextures(1, &s->nearest_tex);
     s->nearest_w = s->nearest_h = 0;
+    while (glGetError() != GL_NO_ERROR)
+        ; /* report only this allocation's error */
     glCreateTextures(GL_TEXTURE_2D, 1, &s->nearest_tex);
     glTextureStorage2D(s->nearest_tex, 1, GL_R32UI, w, h);
     GLenum gl_error = glGetError();
@@ -247,17 +228,22 @@ static sl_status ensure_nearest_image(tubes_state *s, int w, int h, sl_err *err)
     return SL_OK;
 }
 
-/* Draws every segment's boxes with program (uniforms set), counting emitted triangles into stats. */
+/* Draws every segment's boxes with the bound program; with stats, counts the
+ * emitted triangles (2 per face) into it (waits for the query). */
 static void draw_boxes(tubes_state *s, sl_render_stats *stats)
 {
     glBindVertexArray(s->vao);
-    glBeginQuery(GL_PRIMITIVES_GENERATED, s->query);
+    if (stats)
+        glBeginQuery(GL_PRIMITIVES_GENERATED, s->query);
     glDrawElements(GL_LINES, (GLsizei)(2 * s->nodes.segment_count), GL_UNSIGNED_INT, NULL);
-    glEndQuery(GL_PRIMITIVES_GENERATED);
+    if (stats)
+        glEndQuery(GL_PRIMITIVES_GENERATED);
     glBindVertexArray(0);
-    GLuint triangles = 0;
-    glGetQueryObjectuiv(s->query, GL_QUERY_RESULT, &triangles);
-    stats->primitives = (double)triangles; /* triangles rasterized (2 per face) */
+    if (stats) {
+        GLuint triangles = 0;
+        glGetQueryObjectuiv(s->query, GL_QUERY_RESULT, &triangles);
+        stats->primitives = (double)triangles;
+    }
 }
 
 /* occlusion_prepass: four passes into the bound target (depth cleared to 0 = nothing).
@@ -265,7 +251,10 @@ static void draw_boxes(tubes_state *s, sl_render_stats *stats)
  * 2. tubes_depth: boxes with early tests GREATER against D (no writes): the hidden ones never
  *    reach the root search; the survivors' nearest hit depth goes to nearest_tex.
  * 3. tubes_nearest_depth: full-screen, depth := the nearest hit depth (ALWAYS).
- * 4. tubes_shade: boxes with early tests GEQUAL against it; the nearest hit shades. */
+ * 4. tubes_shade: boxes with early tests GEQUAL against it; the nearest hit shades.
+ * With GL_MULTISAMPLE off, a multisampled target gets the single-sample frame in
+ * every sample (per-sample early tests against a pixel-centre depth would drop
+ * samples a box covers only partly); one pass does not anti-alias rims either. */
 static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const sl_params *params,
                                      const sl_line_style *style, sl_render_stats *stats, sl_err *err)
 {
@@ -277,6 +266,7 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
     glEnable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
+    glDisable(GL_MULTISAMPLE);
 
     glUseProgram(s->program_prepass);
     glUniform1f(glGetUniformLocation(s->program_prepass, "u_radius"), style->radius);
@@ -288,7 +278,7 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
     glEnable(GL_PROGRAM_POINT_SIZE);
-    glBindVertexArray(s->vao); /* core profile needs a VAO bound; the pre-pass reads no attribute */
+    glBindVertexArray(s->empty_vao); /* programmable pulling: no attributes */
     glDrawArrays(GL_POINTS, 0, (GLsizei)(3 * s->nodes.segment_count));
     glBindVertexArray(0);
     glDisable(GL_PROGRAM_POINT_SIZE);
@@ -302,7 +292,7 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
     glUseProgram(s->program_nearest);
     glDepthFunc(GL_ALWAYS);
     glDepthMask(GL_TRUE);
-    glBindVertexArray(s->vao);
+    glBindVertexArray(s->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
 
@@ -310,8 +300,10 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthFunc(GL_GEQUAL);
     glDepthMask(GL_FALSE);
-    draw_boxes(s, stats); /* the same triangles as pass 2: primitives counts one pass */
+    draw_boxes(s, NULL); /* the same triangles as pass 2: primitives counts one pass */
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT); /* before the next frame's clear of the image */
     glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+    glEnable(GL_MULTISAMPLE);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
     return SL_OK;
@@ -321,15 +313,15 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
 static int use_prepass(const tubes_state *s, const sl_view *view, const sl_params *params, const sl_line_style *style)
 {
     int mode = sl_params_choice(params, "occlusion_prepass");
-    if (mode != PREPASS_AUTO || s->nodes.segment_count == 0)
-        return mode == PREPASS_ON && s->nodes.segment_count > 0;
+    if (mode != SL_TUBES_PREPASS_AUTO || s->nodes.segment_count == 0)
+        return mode == SL_TUBES_PREPASS_ON && s->nodes.segment_count > 0;
     double bound = sl_dataset_radius(s->dataset);
     sl_vec3 centre = s->dataset->origin, eye = view->camera.eye;
     double dx = eye.x - centre.x, dy = eye.y - centre.y, dz = eye.z - centre.z;
     if (!(bound > 0.0) || dx * dx + dy * dy + dz * dz <= bound * bound)
         return 1;
     double weighted = s->nodes.has_radii ? style->radius_scale * s->length_radius_sum : style->radius * s->length_sum;
-    return 2.0 * weighted / (SL_PI * bound * bound) >= TUBES_PREPASS_MIN_DEPTH_COMPLEXITY;
+    return 2.0 * weighted / (SL_PI * bound * bound) >= SL_TUBES_PREPASS_MIN_DEPTH_COMPLEXITY;
 }
 
 static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,

@@ -14,12 +14,7 @@ flat in vec3 g_r;
 flat in vec2 g_c;
 flat in float g_cm;
 
-uniform sampler2D u_colormap;
-uniform vec2 u_scalar_range;
-uniform int u_use_colormap;
-uniform vec3 u_color;
-uniform vec3 u_light_eye;
-uniform vec4 u_material;
+#include "gpu/glsl/line_style.glsl"
 
 struct tubes_hit {
     vec3 d;        // unit ray direction

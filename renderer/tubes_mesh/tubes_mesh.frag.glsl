@@ -11,12 +11,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in float v_scalar;
 
-uniform sampler2D u_colormap;
-uniform vec2 u_scalar_range;
-uniform int u_use_colormap;
-uniform vec3 u_color;
-uniform vec3 u_light_eye;        // direction to the light in eye space (x right, y up, z to viewer)
-uniform vec4 u_material;         // ambient, diffuse, specular, shininess
+#include "gpu/glsl/line_style.glsl"
 uniform float u_opacity;         // 1: opaque
 
 layout(location = 0) out vec4 o_color;

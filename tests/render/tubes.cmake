@@ -102,6 +102,14 @@ tubes_render_test(prepass.same_frame_dense
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.pfm|${TUBES_OUT}/dense_off.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.png|${TUBES_OUT}/dense_off.png|--max-bad-pct|0.1"
   -P ${TUBES_DIR}/run_steps.cmake)
+# With 4 MSAA samples the pre-pass renders the single-sample frame into every sample.
+tubes_render_test(prepass.msaa_same_as_single
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms4.png|--depth|${TUBES_OUT}/dense_ms4.pfm|--samples|4|--set|params.occlusion_prepass=on"
+  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms1.png|--depth|${TUBES_OUT}/dense_ms1.pfm|--samples|1|--set|params.occlusion_prepass=on"
+  "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.pfm|${TUBES_OUT}/dense_ms1.pfm|--max-abs|0"
+  "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.png|${TUBES_OUT}/dense_ms1.png|--max-abs|1"
+  -P ${TUBES_DIR}/run_steps.cmake)
 # The root methods at the default iterations on the thin-tube scene (the
 # default method is covered by every test above).
 foreach(method bisection illinois newton)
