@@ -48,8 +48,13 @@ sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, con
     if (!f)
         return sl_err_set(err, SL_ERR_IO, "cannot write %s", path);
     const sl_lines *l = &ds->lines;
+    char title[sizeof ds->name];
+    snprintf(title, sizeof title, "%s", ds->name);
+    for (char *c = title; *c; c++)
+        if (*c == '\n' || *c == '\r')
+            *c = ' '; /* the title is one line of the format */
     fprintf(f, "# vtk DataFile Version 3.0\nsightline benchmark %s\nBINARY\nDATASET POLYDATA\nPOINTS %zu float\n",
-            ds->name, l->vertex_count);
+            title, l->vertex_count);
     for (size_t k = 0; k < 3 * l->vertex_count; k++)
         put_be_float(l->positions[k], f);
     fprintf(f, "\nLINES %zu %zu\n", l->line_count, l->line_count + l->vertex_count);
@@ -245,9 +250,13 @@ void sl_bench_peer_vtk_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_res
     snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 %dx%dx24' /usr/bin/python3 ", o->width > 1280 ? o->width : 1280,
              o->height > 1024 ? o->height : 1024);
     append_quoted(cmd, sizeof cmd, script);
+    strncat(cmd, " --lines ", sizeof cmd - strlen(cmd) - 1);
+    append_quoted(cmd, sizeof cmd, d->files->lines);
+    strncat(cmd, " --cameras ", sizeof cmd - strlen(cmd) - 1);
+    append_quoted(cmd, sizeof cmd, d->files->cameras);
     size_t n = strlen(cmd);
-    snprintf(cmd + n, sizeof cmd - n, " --lines %s --cameras %s --size %dx%d --radius %.9g --sides %d --caps %d 2>&1",
-             d->files->lines, d->files->cameras, o->width, o->height, d->radius, d->sides, d->caps);
+    snprintf(cmd + n, sizeof cmd - n, " --size %dx%d --radius %.9g --sides %d --caps %d 2>&1", o->width, o->height,
+             d->radius, d->sides, d->caps);
     run_peer(cmd, d, "vtk_tubes.py", r);
 }
 
@@ -273,8 +282,12 @@ void sl_bench_peer_embree_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_
     const sl_bench_options *o = d->options;
     char cmd[16384] = "";
     append_quoted(cmd, sizeof cmd, exe);
+    strncat(cmd, " --lines ", sizeof cmd - strlen(cmd) - 1);
+    append_quoted(cmd, sizeof cmd, d->files->lines);
+    strncat(cmd, " --cameras ", sizeof cmd - strlen(cmd) - 1);
+    append_quoted(cmd, sizeof cmd, d->files->cameras);
     size_t len = strlen(cmd);
-    snprintf(cmd + len, sizeof cmd - len, " --lines %s --cameras %s --size %dx%d --radius %.9g --threads %d 2>&1",
-             d->files->lines, d->files->cameras, o->width, o->height, d->radius, d->threads > 0 ? d->threads : 1);
+    snprintf(cmd + len, sizeof cmd - len, " --size %dx%d --radius %.9g --threads %d 2>&1", o->width, o->height,
+             d->radius, d->threads > 0 ? d->threads : 1);
     run_peer(cmd, d, "peer-embree-tubes", r);
 }
