@@ -32,6 +32,10 @@ enum { SL_TUBES_PREPASS_AUTO, SL_TUBES_PREPASS_ON, SL_TUBES_PREPASS_OFF };
  * 1280x720 on llvmpipe (random_walk in a +-3 box): 0.7 lost (5.5 s vs 4.0
  * one pass), 2.1 won (8.9 vs 10.8), 4.2 won 3x, 7 won 4x. */
 #define SL_TUBES_PREPASS_MIN_DEPTH_COMPLEXITY 1.2
+/* ... and it costs a second box pass, which small images do not win back:
+ * bundle (105k segments, far) 415 vs 366 ms one pass at 160x90, but 542 vs
+ * 962 at 320x180 and 964 vs 2451 at 640x360. */
+#define SL_TUBES_PREPASS_MIN_PIXELS 20000
 
 static const sl_param_def tubes_params[] = {
     SL_LINE_STYLE_PARAMS,
@@ -51,8 +55,9 @@ static const sl_param_def tubes_params[] = {
      "(4 vertices instead of up to 12; 0: always faces, as the paper)", SL_INVALIDATE_FRAME},
     {"occlusion_prepass", SL_PARAM_ENUM, 0, 0, {0}, prepass_modes, "",
      "occluder depth pre-pass (spheres inside the sweep), then early depth tests keep hidden boxes from the root "
-     "search: two box passes instead of one, far fewer root searches where tubes hide each other; auto = on when "
-     "the estimated depth complexity is at least 1.2, or the eye is inside the data's bounding sphere",
+     "search: two box passes instead of one, far fewer root searches where tubes hide each other; auto = on from "
+     "20000 pixels up when the estimated depth complexity is at least 1.2 or the eye is inside the data's bounding "
+     "sphere",
      SL_INVALIDATE_FRAME},
     {"silhouette_only", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
      "discard every fragment (measures the silhouette cost; draws nothing)", SL_INVALIDATE_FRAME},
@@ -315,6 +320,8 @@ static int use_prepass(const tubes_state *s, const sl_view *view, const sl_param
     int mode = sl_params_choice(params, "occlusion_prepass");
     if (mode != SL_TUBES_PREPASS_AUTO || s->nodes.segment_count == 0)
         return mode == SL_TUBES_PREPASS_ON && s->nodes.segment_count > 0;
+    if ((double)view->width * view->height < SL_TUBES_PREPASS_MIN_PIXELS)
+        return 0;
     double bound = sl_dataset_radius(s->dataset);
     sl_vec3 centre = s->dataset->origin, eye = view->camera.eye;
     double dx = eye.x - centre.x, dy = eye.y - centre.y, dz = eye.z - centre.z;
