@@ -163,6 +163,15 @@ static void append_quoted(char *cmd, size_t size, const char *s)
     cmd[n] = 0;
 }
 
+/* Appends " --lines FILE --cameras FILE", quoted, to the shell command. */
+static void append_files(char *cmd, size_t size, const sl_bench_peer_files *files)
+{
+    strncat(cmd, " --lines ", size - strlen(cmd) - 1);
+    append_quoted(cmd, size, files->lines);
+    strncat(cmd, " --cameras ", size - strlen(cmd) - 1);
+    append_quoted(cmd, size, files->cameras);
+}
+
 static double json_number(const cJSON *o, const char *key)
 {
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
@@ -250,10 +259,7 @@ void sl_bench_peer_vtk_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_res
     snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 %dx%dx24' /usr/bin/python3 ", o->width > 1280 ? o->width : 1280,
              o->height > 1024 ? o->height : 1024);
     append_quoted(cmd, sizeof cmd, script);
-    strncat(cmd, " --lines ", sizeof cmd - strlen(cmd) - 1);
-    append_quoted(cmd, sizeof cmd, d->files->lines);
-    strncat(cmd, " --cameras ", sizeof cmd - strlen(cmd) - 1);
-    append_quoted(cmd, sizeof cmd, d->files->cameras);
+    append_files(cmd, sizeof cmd, d->files);
     size_t n = strlen(cmd);
     snprintf(cmd + n, sizeof cmd - n, " --size %dx%d --radius %.9g --sides %d --caps %d 2>&1", o->width, o->height,
              d->radius, d->sides, d->caps);
@@ -282,10 +288,7 @@ void sl_bench_peer_embree_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_
     const sl_bench_options *o = d->options;
     char cmd[16384] = "";
     append_quoted(cmd, sizeof cmd, exe);
-    strncat(cmd, " --lines ", sizeof cmd - strlen(cmd) - 1);
-    append_quoted(cmd, sizeof cmd, d->files->lines);
-    strncat(cmd, " --cameras ", sizeof cmd - strlen(cmd) - 1);
-    append_quoted(cmd, sizeof cmd, d->files->cameras);
+    append_files(cmd, sizeof cmd, d->files);
     size_t len = strlen(cmd);
     snprintf(cmd + len, sizeof cmd - len, " --size %dx%d --radius %.9g --threads %d 2>&1", o->width, o->height,
              d->radius, d->threads > 0 ? d->threads : 1);

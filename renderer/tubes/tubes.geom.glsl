@@ -77,9 +77,17 @@ void emit_box(vec3 b0, vec3 b1, vec3 b2, vec3 r, vec3 c)
         x = normalize(tan1);
     else
         x = vec3(1, 0, 0);
+    // y: the tangent off x, unless that is rounding noise. The noise of v scales with the
+    // control points' magnitude (they are relative to the dataset origin), not with |tan1|:
+    // a nearly collinear fold (a tangent tilted by 1e-7) left v ~ 6e-8 of noise above a
+    // threshold of 1e-6 |tan1|, and normalize(noise) is no vector orthogonal to x; the box
+    // then missed part of the sweep (0.05 r depth errors). Hence the threshold on the
+    // larger of both, and y is made orthogonal to x again whatever chose it.
     vec3 v = tan1 - x * dot(tan1, x);
-    vec3 y = length(v) > 1e-6 * max(length(tan1), 1e-30) ? normalize(v) : any_orthogonal(x);
-    vec3 z = cross(x, y);
+    float noise = 1e-5 * max(max(length(tan1), length(b0)), max(length(b1), length(b2)));
+    vec3 y = length(v) > noise ? normalize(v) : any_orthogonal(x);
+    y = normalize(y - x * dot(y, x));
+    vec3 z = normalize(cross(x, y));
     mat3 axes = mat3(x, y, z);
     vec3 lo, hi;
     for (int a = 0; a < 3; a++) {

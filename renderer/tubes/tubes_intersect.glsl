@@ -228,6 +228,20 @@ int tubes_refine(int which, float k[12], int n, out float r[12])
 // Power-basis coefficients of a quadratic Bezier (c0, c1, c2): c0 + B t + A t^2.
 vec3 bezier_power(float c0, float c1, float c2) { return vec3(c0, 2.0 * (c1 - c0), c0 - 2.0 * c1 + c2); }
 
+// Keeps t when the entry into its sphere (distance h - sqrt(g)) lies beyond l_min and
+// before the best so far.
+void tubes_consider(float t, vec3 pr, vec3 py, vec3 pz, vec3 ph, float l_min, inout float l_hit,
+                    inout float t_hit, inout bool found)
+{
+    float r = quad(pr, t), y = quad(py, t), z = quad(pz, t);
+    float l = quad(ph, t) - sqrt(max(r * r - y * y - z * z, 0.0));
+    if (l >= l_min && l < l_hit) {
+        l_hit = l;
+        t_hit = t;
+        found = true;
+    }
+}
+
 // Returns true and the nearest entry beyond l_min: distance l and parameter t.
 // q0..q2: control points relative to the ray origin; d: unit direction.
 bool tubes_intersect(vec3 q0, vec3 q1, vec3 q2, vec3 rc, vec3 d, float l_min, out float l_hit, out float t_hit)
@@ -268,6 +282,15 @@ bool tubes_intersect(vec3 q0, vec3 q1, vec3 q2, vec3 rc, vec3 d, float l_min, ou
     H1[0] = ph.y * k;
     H1[1] = 2.0 * ph.z * k;
     float G2 = c[2] / big, G3 = c[3] / big, G4 = c[4] / big;   // for the knots only
+    // The parameter of the curve's smallest speed |p'(t)| (a quadratic in t). Where the
+    // sub-segment folds back on itself (collinear controls, the curve running past an end
+    // and returning), p' vanishes there, so f''' = 0 there for every ray on top of up to
+    // two other roots: the "at most one root of f'''" assumption fails, and a minimum of f
+    // was lost (0.09 r depth errors). It is a knot of the f''' search; elsewhere it only
+    // splits an interval once more.
+    vec3 e1 = q1 - q0, ed = (q1 - q0) - (q2 - q1);
+    float ed2 = dot(ed, ed);
+    float t_slow = ed2 > 0.0 ? dot(e1, ed) / ed2 : -1.0;
 
     // Roots of g'' analytically, then g', then g.
     float knots[12], roots[12];
@@ -302,32 +325,36 @@ bool tubes_intersect(vec3 q0, vec3 q1, vec3 q2, vec3 rc, vec3 d, float l_min, ou
         float a = knots[i], b = knots[j];
         i = j;
         float k3[12], k2s[12], k1[12];
-        k3[0] = a; k3[1] = b;
-        int m3 = tubes_refine(2, k3, 2, k2s);   // knots a, [f''' root], b
+        int n3 = 0;
+        k3[n3++] = a;
+        if (t_slow > a && t_slow < b)
+            k3[n3++] = t_slow;
+        k3[n3++] = b;
+        int m3 = tubes_refine(2, k3, n3, k2s);  // knots a, [t_slow], b and the f''' roots between
         int m2 = tubes_refine(3, k2s, m3, k1);  // + f'' roots: f' monotone between
-        // Candidates: t = 0 and t = 1 when inside the interval, and every
-        // - to + crossing of f' (a local minimum of f).
+        // Candidates: t = 0 and t = 1 when inside the interval, and every local
+        // minimum of f: a - to + crossing of f' inside a piece between knots (f' is
+        // monotone there), or a knot where f' is exactly 0 between a negative and a
+        // positive neighbour. The latter was lost before: at a collinear fold f' is 0 in
+        // float exactly on the root of f''' that is a knot, so neither piece beside it
+        // shows a crossing. (Only minima: for a ray starting inside the sweep an entry
+        // into some sphere t can lie inside others, so no other t may be taken.)
+        if (a == 0.0)
+            tubes_consider(0.0, pr, py, pz, ph, l_min, l_hit, t_hit, found);
+        if (b == 1.0)
+            tubes_consider(1.0, pr, py, pz, ph, l_min, l_hit, t_hit, found);
+        float f_prev = 0.0;
         float fa = tubes_eval(4, k1[0]);
-        float cand[4];
-        int nc = 0;
-        if (a == 0.0) cand[nc++] = 0.0;
-        if (b == 1.0) cand[nc++] = 1.0;
         for (int e = 0; e + 1 < m2; e++) {
             float fb = tubes_eval(4, k1[e + 1]);
-            if (fa < 0.0 && fb > 0.0 && nc < 4)
-                cand[nc++] = u_method >= 2 ? tubes_root_f1(a, b, k1[e], k1[e + 1], fa, fb)
-                                            : tubes_root(4, k1[e], k1[e + 1], fa, fb);
+            if (fa < 0.0 && fb > 0.0)
+                tubes_consider(u_method >= 2 ? tubes_root_f1(a, b, k1[e], k1[e + 1], fa, fb)
+                                             : tubes_root(4, k1[e], k1[e + 1], fa, fb),
+                               pr, py, pz, ph, l_min, l_hit, t_hit, found);
+            if (e > 0 && fa == 0.0 && f_prev < 0.0 && fb > 0.0)
+                tubes_consider(k1[e], pr, py, pz, ph, l_min, l_hit, t_hit, found);
+            f_prev = fa;
             fa = fb;
-        }
-        for (int e = 0; e < nc; e++) {
-            float t = cand[e];
-            float r = quad(pr, t), y = quad(py, t), z = quad(pz, t);
-            float l = quad(ph, t) - sqrt(max(r * r - y * y - z * z, 0.0));
-            if (l >= l_min && l < l_hit) {
-                l_hit = l;
-                t_hit = t;
-                found = true;
-            }
         }
     }
     return found;

@@ -110,6 +110,18 @@ tubes_render_test(prepass.msaa_same_as_single
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.pfm|${TUBES_OUT}/dense_ms1.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.png|${TUBES_OUT}/dense_ms1.png|--max-abs|1"
   -P ${TUBES_DIR}/run_steps.cmake)
+# Folds: segments whose curve runs past their end and returns inside their own tube,
+# exactly collinear (axis-aligned and seeded directions) and nearly so (first tangent
+# tilted by 1e-7 to 1e-2 of its length). Two faults lived here: the box frame took
+# rounding noise for a direction (near-collinear), and a minimum of f sitting exactly
+# on a root of f-triple-prime went unseen (collinear); 192x192 as measured in issue 11.
+tubes_render_test(accuracy.stress_fold_axis tubes-check --scene ${TUBES_DIR}/stress_fold_axis.json)
+foreach(axis x y z any)
+  foreach(tilt 0 1e-7 1e-4 1e-2)
+    tubes_render_test(accuracy.folds_${axis}_tilt_${tilt}
+      tubes-check --scene ${TUBES_DIR}/folds.json --random-folds 6 --fold-axis ${axis} --fold-tilt ${tilt} --seed 1)
+  endforeach()
+endforeach()
 # The root methods at the default iterations on the thin-tube scene (the
 # default method is covered by every test above).
 foreach(method bisection illinois newton)

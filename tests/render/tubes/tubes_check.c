@@ -3,7 +3,8 @@
  * usage: tubes-check --scene S.json [--set key.path=value ...] [--gpu-depth G.pfm]
  *          [--out-gpu G.pfm] [--out-png G.png] [--out-ref R.pfm] [--out-radius R.pfm] [--cubic-ref C.pfm]
  *          [--tol 1e-3] [--rim-tol 0.05] [--max-mismatch-pct 0.5] [--ref-samples N] [--data-dir DIR]
- *          [--random-segments N --seed S] [--write-scene OUT.json] [--culling-check]
+ *          [--random-segments N --seed S] [--random-folds N --fold-axis x|y|z|any --fold-tilt T --seed S]
+ *          [--write-scene OUT.json] [--culling-check]
  * Loads the scene's dataset (explicit Hermite JSON, inline or as a .json file,
  * is read by sl_hermite_dataset_from_json; everything else as sightline-render
  * does), renders the GPU distance map (or reads --gpu-depth, e.g. from
@@ -19,6 +20,11 @@
  * dataset by N random Hermite segments (chains and bifurcations, varying
  * radius and tangents) from --seed. --write-scene writes the scene as checked
  * (overrides and random dataset included) for sightline-render.
+ * --random-folds replaces it by N segments that fold back on themselves: chord
+ * 0.1-0.3 along the axis (or a seeded direction), end tangents +k and -k
+ * along it (k 0.8-1.5: the curve runs past its end and returns inside its own
+ * tube), radius 0.2-0.4; --fold-tilt T tilts the first tangent by T x k off
+ * the line (near-collinear).
  * --culling-check instead renders with frustum culling on and off and checks
  * fewer primitives, identical pixels and no re-prepare. Exit 0 pass,
  * 1 fail, 2 bad input, 3 GPU. */
@@ -45,14 +51,16 @@
 typedef struct options {
     const char *scene, *gpu_depth, *out_png, *out_gpu, *out_ref, *out_radius, *cubic_ref, *data_dir, *write_scene;
     const char *sets[MAX_SETS];
-    int set_count, ref_samples, random_segments, culling_check;
+    int set_count, ref_samples, random_segments, random_folds, culling_check;
+    char fold_axis;       /* 'x', 'y', 'z' or 'a' (any: a seeded direction) */
+    double fold_tilt;
     unsigned long long seed;
     double tol, rim_tol, max_mismatch_pct;
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
 {
-    *o = (options){.tol = 1e-3, .rim_tol = 0.05, .max_mismatch_pct = 0.5};
+    *o = (options){.tol = 1e-3, .rim_tol = 0.05, .max_mismatch_pct = 0.5, .fold_axis = 'x'};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--culling-check") == 0) { o->culling_check = 1; continue; }
@@ -72,6 +80,10 @@ static int parse_args(int argc, char **argv, options *o)
         else if (strcmp(a, "--max-mismatch-pct") == 0) o->max_mismatch_pct = atof(v);
         else if (strcmp(a, "--ref-samples") == 0) o->ref_samples = atoi(v);
         else if (strcmp(a, "--random-segments") == 0) o->random_segments = atoi(v);
+        else if (strcmp(a, "--random-folds") == 0) o->random_folds = atoi(v);
+        else if (strcmp(a, "--fold-axis") == 0 && strchr("xyz", v[0]) && v[0] && !v[1]) o->fold_axis = v[0];
+        else if (strcmp(a, "--fold-axis") == 0 && strcmp(v, "any") == 0) o->fold_axis = 'a';
+        else if (strcmp(a, "--fold-tilt") == 0) o->fold_tilt = atof(v);
         else if (strcmp(a, "--seed") == 0) o->seed = strtoull(v, NULL, 10);
         else if (strcmp(a, "--set") == 0 && o->set_count < MAX_SETS) o->sets[o->set_count++] = v;
         else { fprintf(stderr, "tubes-check: unknown option %s\n", a); return -1; }
@@ -112,6 +124,51 @@ static cJSON *random_hermite(int n, unsigned long long seed)
     for (int k = 0; k < n; k++) {
         int a = (k % 5 == 4) ? (int)rnd(&st, 0, k) : k;
         const int pair[2] = {a, k + 1};
+        cJSON_AddItemToArray(segs, cJSON_CreateIntArray(pair, 2));
+    }
+    return root;
+}
+
+/* N folded segments (see --random-folds): each its own pair of nodes. */
+static cJSON *random_folds(int n, unsigned long long seed, char axis, double tilt)
+{
+    unsigned long long st = seed * 2654435761ull + 7;
+    cJSON *root = cJSON_CreateObject(), *nodes = cJSON_AddArrayToObject(root, "nodes");
+    cJSON *segs = cJSON_AddArrayToObject(root, "segments");
+    for (int k = 0; k < n; k++) {
+        double dir[3] = {axis == 'x', axis == 'y', axis == 'z'};
+        if (axis == 'a') {
+            double len = 0.0;
+            while (len < 0.1) {
+                for (int c = 0; c < 3; c++)
+                    dir[c] = rnd(&st, -1, 1);
+                len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+            }
+            for (int c = 0; c < 3; c++)
+                dir[c] /= len;
+        }
+        /* A unit vector off the line, for the tilt. */
+        double off[3] = {fabs(dir[0]) < 0.9 ? 1.0 : 0.0, fabs(dir[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+        double dot = off[0] * dir[0] + off[1] * dir[1];
+        double ol = 0.0;
+        for (int c = 0; c < 3; c++) {
+            off[c] -= dot * dir[c];
+            ol += off[c] * off[c];
+        }
+        ol = sqrt(ol);
+        double chord = rnd(&st, 0.1, 0.3), kk = rnd(&st, 0.8, 1.5), r = rnd(&st, 0.2, 0.4);
+        double p0[3] = {rnd(&st, -1, 1), rnd(&st, -1, 1), rnd(&st, -1, 1)};
+        cJSON *a = cJSON_CreateObject(), *b = cJSON_CreateObject();
+        cJSON_AddItemToObject(a, "p", vec3_json(p0[0], p0[1], p0[2]));
+        cJSON_AddItemToObject(a, "t", vec3_json(kk * (dir[0] + tilt * off[0] / ol), kk * (dir[1] + tilt * off[1] / ol),
+                                               kk * (dir[2] + tilt * off[2] / ol)));
+        cJSON_AddNumberToObject(a, "r", r);
+        cJSON_AddItemToObject(b, "p", vec3_json(p0[0] + chord * dir[0], p0[1] + chord * dir[1], p0[2] + chord * dir[2]));
+        cJSON_AddItemToObject(b, "t", vec3_json(-kk * dir[0], -kk * dir[1], -kk * dir[2]));
+        cJSON_AddNumberToObject(b, "r", r);
+        cJSON_AddItemToArray(nodes, a);
+        cJSON_AddItemToArray(nodes, b);
+        const int pair[2] = {2 * k, 2 * k + 1};
         cJSON_AddItemToArray(segs, cJSON_CreateIntArray(pair, 2));
     }
     return root;
@@ -285,6 +342,10 @@ int main(int argc, char **argv)
     if (root && o.random_segments > 0) {
         cJSON_DeleteItemFromObjectCaseSensitive(root, "dataset");
         cJSON_AddItemToObject(root, "dataset", random_hermite(o.random_segments, o.seed));
+    }
+    if (root && o.random_folds > 0) {
+        cJSON_DeleteItemFromObjectCaseSensitive(root, "dataset");
+        cJSON_AddItemToObject(root, "dataset", random_folds(o.random_folds, o.seed, o.fold_axis, o.fold_tilt));
     }
     if (root && o.write_scene) {
         /* The scene as checked (overrides applied, random dataset inline), for
