@@ -27,6 +27,7 @@
 
 #include <libwebsockets.h>
 
+#include "core/sl_clock.h"
 #include "core/sl_technique.h"
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
@@ -183,7 +184,7 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
     view.origin = ds->origin;
     if ((rc = sl_view_init(&view, sl_dataset_radius(ds), err)) != SL_OK)
         return rc;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_frame_stats stats;
     if ((rc = sl_pipeline_render(s->pipeline, &view, 1, &stats, err)) != SL_OK)
         return rc;
@@ -191,7 +192,7 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return rc;
     *w_out = w;
     *h_out = h;
-    *render_ms = sl_now_ms() - t0;
+    *render_ms = sl_clock_ms() - t0;
     *prepare_ms = stats.prepare_ms;
     return SL_OK;
 }
@@ -225,7 +226,7 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     sl_err err = {0};
     int w = 0, h = 0, step = 0;
     double render_ms = 0, prepare_ms = 0, encode_ms = 0;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_frame_buf *f = NULL;
     sl_iscale_sync(&s->iscale, scene_key(st), st->stream.interactive_scale);
     double scale = interactive ? sl_iscale_choose(&s->iscale, &st->stream, &step) : 1.0;
@@ -233,10 +234,10 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
         report_error(ctx->srv, s, st, &err);
         return;
     }
-    double t_read = sl_now_ms();
+    double t_read = sl_clock_ms();
     sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 0);
     test_delay(ctx->srv, st, w, h);
-    double t_done = sl_now_ms();
+    double t_done = sl_clock_ms();
     double cost_ms = render_ms - prepare_ms + (t_done - t_read);
     render_ms = t_done - t0;
     int quality = interactive ? st->stream.interactive_quality : st->stream.still_quality;
@@ -335,7 +336,7 @@ static void *render_main(void *arg)
     sl_session_state *copy = malloc(sizeof *copy);
     while (!srv->stop && copy) {
         reap(srv);
-        double now = sl_server_now_ms();
+        double now = sl_clock_ms();
         double deadline = now + 1000.0;
         enum job_kind kind = JOB_NONE;
         sl_session *s = pick_job(srv, &ctx.rr, &kind, now, &deadline);
@@ -343,11 +344,7 @@ static void *render_main(void *arg)
             double wait = deadline - now;
             if (wait < 1)
                 wait = 1;
-            struct timespec ts;
-            clock_gettime(CLOCK_MONOTONIC, &ts);
-            long long ns = ts.tv_nsec + (long long)(wait * 1e6);
-            ts.tv_sec += (time_t)(ns / 1000000000LL);
-            ts.tv_nsec = (long)(ns % 1000000000LL);
+            struct timespec ts = sl_clock_deadline(wait);
             pthread_cond_timedwait(&srv->wake, &srv->lock, &ts);
             continue;
         }

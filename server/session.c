@@ -37,7 +37,7 @@ static void random_hex(char *out, int bytes)
     unsigned char buf[32];
     if (getrandom(buf, (size_t)bytes, 0) != bytes) {
         /* getrandom on Linux does not fail for <= 256 bytes once seeded; mix the clock in as a fallback. */
-        double t = sl_server_now_ms();
+        double t = sl_clock_ms();
         for (int i = 0; i < bytes; i++)
             buf[i] = (unsigned char)((long long)(t * 1000.0) >> (i % 8) ^ (unsigned)rand());
     }
@@ -259,7 +259,7 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     st->height = height > 0 ? height : 480;
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
     st->stream = SL_STREAM_DEFAULTS;
-    s->empty_since_ms = sl_server_now_ms();
+    s->empty_since_ms = sl_clock_ms();
     pthread_mutex_lock(&srv->lock);
     s->next = srv->sessions;
     srv->sessions = s;
@@ -526,7 +526,7 @@ static void on_camera(sl_server *srv, sl_client *c, const sl_msg *m)
     memcpy(s->state.camera_json, cam, sizeof cam);
     s->state.camera_seq = (uint32_t)m->seq;
     s->state.phase = m->phase;
-    s->state.camera_ms = sl_server_now_ms();
+    s->state.camera_ms = sl_clock_ms();
     state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
@@ -712,7 +712,7 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
         if (s->controller == c->id)
             pass_control(s, c->id);
         if (s->client_count == 0)
-            s->empty_since_ms = sl_server_now_ms();
+            s->empty_since_ms = sl_clock_ms();
         pthread_mutex_lock(&srv->lock);
         for (int i = 0; i < s->snap_req_count; i++)
             if (s->snap_req[i] == c->id)
@@ -902,7 +902,7 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
 
 void sl_sessions_sweep(sl_server *srv)
 {
-    double now = sl_server_now_ms();
+    double now = sl_clock_ms();
     /* One expired session per pass under the lock; its catalog row is deleted
      * after unlocking, so a WAL commit never stalls the render thread. */
     for (;;) {

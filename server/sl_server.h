@@ -10,7 +10,7 @@
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
- *   clock.c    monotonic milliseconds, the one time source (any thread)
+ * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
  * render thread owns every GL object. They share only the fields marked
@@ -36,6 +36,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_clock.h"
 #include "core/sl_params.h"
 #include "core/sl_status.h"
 #include "sl_protocol.h"
@@ -325,8 +326,5 @@ char *sl_http_metrics(sl_server *srv);
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
 void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted);
 void sl_ws_destroy(sl_server *srv);
-
-/* clock.c */
-double sl_server_now_ms(void);
 
 #endif
