@@ -27,11 +27,11 @@
 
 #include <libwebsockets.h>
 
+#include "core/sl_camera.h"
 #include "core/sl_clock.h"
 #include "core/sl_technique.h"
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
-#include "sl_scene.h"
 
 enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT };
 
@@ -159,16 +159,9 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return sl_err_set(err, SL_ERR_INVALID, "technique \"%s\" is not in this build", st->technique);
     if ((rc = sl_pipeline_set_technique(s->pipeline, t, &st->params, err)) != SL_OK)
         return rc;
-    cJSON *cam = cJSON_Parse(st->camera_json);
     sl_view view;
     memset(&view, 0, sizeof view);
-    int is_orbit = 0;
-    sl_orbit orbit;
-    rc = sl_camera_json_parse(cam, &is_orbit, &view.camera, &orbit, err);
-    cJSON_Delete(cam);
-    if (rc)
-        return rc;
-    if (is_orbit && (rc = sl_camera_from_orbit(&orbit, ds->bounds_min, ds->bounds_max, &view.camera, err)))
+    if ((rc = sl_camera_spec_resolve(&st->camera, ds->bounds_min, ds->bounds_max, &view.camera, err)) != SL_OK)
         return rc;
     int w = st->width, h = st->height;
     if (scale < 1) {

@@ -50,7 +50,6 @@ typedef struct sl_dataset sl_dataset;
 #define SL_SERVER_MAX_DATA_DIRS 8
 #define SL_CLIENT_MAX_TEXT 32          /* queued replies to the client's own requests; more closes it */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
-#define SL_CAMERA_JSON_MAX 1024
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
 
@@ -112,7 +111,7 @@ typedef struct sl_session_state {
     int dataset_kind;
     char technique[SL_PROTO_NAME_MAX];
     sl_params params;
-    char camera_json[SL_CAMERA_JSON_MAX];/* validated camera object */
+    sl_camera_spec camera;               /* checked on arrival (sl_msg_camera_check) */
     uint32_t camera_seq;
     sl_camera_phase phase;
     double camera_ms;                    /* time of the last camera message */

@@ -274,6 +274,14 @@ int main(void)
     SL_CHECK(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a.welcome, "datasets")) >= 2);
     SL_CHECK(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "limits"), "ack_window")
                  ->valueint == 2);
+    /* The page's camera numbers: a new session starts at camera_default, and the limit is core's. */
+    {
+        const cJSON *me = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "limits"),
+                                                           "max_elevation");
+        SL_CHECK(cJSON_IsNumber(me) && me->valuedouble == SL_ORBIT_MAX_ELEVATION);
+        const cJSON *cd = cJSON_GetObjectItemCaseSensitive(a.welcome, "camera_default");
+        SL_CHECK(cJSON_IsObject(cd) && cJSON_Compare(cd, cJSON_GetObjectItemCaseSensitive(wst, "camera"), 1));
+    }
     a.auto_ack = 1;
 
     /* --- first frame arrives, header valid, decodes to the session size, shows something --- */
@@ -387,6 +395,13 @@ int main(void)
         const cJSON *seq = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "camera_seq");
         SL_CHECK_MSG(v0 > 0 && v1 == v0 + 1, "state version %u -> %u across refused cameras", v0, v1);
         SL_CHECK(seq && seq->valueint == 70);
+        /* The state echoes the parsed camera, complete: the fov the client left out is the default. */
+        const cJSON *pc = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "camera");
+        const cJSON *fov = cJSON_GetObjectItemCaseSensitive(pc, "fov_y");
+        SL_CHECK_MSG(cJSON_IsNumber(fov) && fov->valuedouble == sl_orbit_default.fov_y_deg &&
+                         cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(pc, "orbit"), "azimuth")
+                                 ->valuedouble == 15.0,
+                     "camera echo is not complete");
         cJSON_Delete(m);
         int render_failed = 0;
         int got = wait_still_counting_errors(&a, 70, &render_failed);
