@@ -78,11 +78,11 @@ static void *run_viewer(void *arg)
     v->ok = 1;
     tclient_wait_frame(&c, 0, 0, 30000);
     int base = c.frames;
-    v->first_ms = harness_now_ms();
+    v->first_ms = sl_clock_ms();
     while (!atomic_load(v->stop))
         if (tclient_next(&c, 50, NULL) == 0)
             break;
-    v->last_ms = harness_now_ms();
+    v->last_ms = sl_clock_ms();
     v->frames = c.frames - base;
     tclient_close(&c);
     return NULL;
@@ -122,7 +122,7 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
     uint32_t seq = 0;
     /* Interactive latency: one move at a time, next after its frame is shown. */
     for (int i = 0; i < 40; i++) {
-        double t0 = harness_now_ms();
+        double t0 = sl_clock_ms();
         send_camera(&ctl, ++seq, "move", i * 3.0);
         if (tclient_wait_frame(&ctl, seq, 0, 30000) != 0)
             break;
@@ -132,7 +132,7 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
     tclient_wait_frame(&ctl, seq, 1, 30000);
     /* Still latency: one-off changes. */
     for (int i = 0; i < 20; i++) {
-        double t0 = harness_now_ms();
+        double t0 = sl_clock_ms();
         send_camera(&ctl, ++seq, NULL, 130.0 + i * 5.0);
         if (tclient_wait_frame(&ctl, seq, 1, 30000) != 0)
             break;
@@ -153,8 +153,8 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
         }
         usleep(500000);
         int base = ctl.frames;
-        double t0 = harness_now_ms(), az = 0;
-        while (harness_now_ms() - t0 < seconds * 1000.0) {
+        double t0 = sl_clock_ms(), az = 0;
+        while (sl_clock_ms() - t0 < seconds * 1000.0) {
             send_camera(&ctl, ++seq, "move", az += 2.0);
             if (tclient_wait_frame(&ctl, seq, 0, 30000) != 0)
                 break;
@@ -167,7 +167,7 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
                 ih = ctl.last.h.height;
             }
         }
-        double ctl_fps = (ctl.frames - base) / ((harness_now_ms() - t0) / 1000.0);
+        double ctl_fps = (ctl.frames - base) / ((sl_clock_ms() - t0) / 1000.0);
         atomic_store(&stop, 1);
         double sum = ctl_fps, mn = ctl_fps;
         for (int i = 0; i < nv; i++) {
@@ -233,15 +233,15 @@ typedef struct drag_row {
 /* Waits for a `state` message, then for a still frame showing at least its version. */
 static int wait_state_still(tclient *c, int timeout_ms)
 {
-    double deadline = harness_now_ms() + timeout_ms;
+    double deadline = sl_clock_ms() + timeout_ms;
     cJSON *st = tclient_wait_type(c, "state", timeout_ms);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(st, "version");
     uint32_t version = cJSON_IsNumber(v) ? (uint32_t)v->valuedouble : 0;
     cJSON_Delete(st);
     if (!version)
         return -1;
-    while (harness_now_ms() < deadline) {
-        int r = tclient_next(c, (int)(deadline - harness_now_ms()) + 1, NULL);
+    while (sl_clock_ms() < deadline) {
+        int r = tclient_next(c, (int)(deadline - sl_clock_ms()) + 1, NULL);
         if (r == 2 && c->last.h.kind == SL_FRAME_JPEG && !(c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE) &&
             c->last.h.state_version >= version)
             return 0;
@@ -272,16 +272,16 @@ static void drag_once(tclient *c, uint32_t *seq, const char *dataset, const char
     r->still_cost_ms = c->last.h.render_ms + c->last.h.encode_ms;
     static double sent[DRAG_MAX_SEQ];
     uint32_t first = *seq + 1;
-    double t0 = harness_now_ms(), next = t0, az = 0, t_end = t0 + drag_s * 1000.0;
-    while (harness_now_ms() < t_end) {
-        double now = harness_now_ms();
+    double t0 = sl_clock_ms(), next = t0, az = 0, t_end = t0 + drag_s * 1000.0;
+    while (sl_clock_ms() < t_end) {
+        double now = sl_clock_ms();
         if (now >= next) {
             send_camera(c, ++*seq, "move", az += 1.5);
             if (*seq - first < DRAG_MAX_SEQ)
                 sent[*seq - first] = now;
             next += 1000.0 / DRAG_HZ;
         }
-        int wait = (int)(fmin(next, t_end) - harness_now_ms());
+        int wait = (int)(fmin(next, t_end) - sl_clock_ms());
         if (tclient_next(c, wait < 1 ? 1 : wait, NULL) != 2 || c->last.h.kind != SL_FRAME_JPEG ||
             !(c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE) || c->last.h.camera_seq < first)
             continue;
@@ -298,7 +298,7 @@ static void drag_once(tclient *c, uint32_t *seq, const char *dataset, const char
             r->widths[r->nwidths++] = r->last_w;
     }
     r->fps = r->frames / drag_s;
-    double t_sent_end = harness_now_ms();
+    double t_sent_end = sl_clock_ms();
     send_camera(c, ++*seq, "end", az);
     if (tclient_wait_frame(c, *seq, 1, timeout) != 0) {
         snprintf(r->why, sizeof r->why, "no still frame after the drag");

@@ -71,7 +71,7 @@ static sl_status get_vec3(const cJSON *obj, const char *key, const char *path, s
     return SL_OK;
 }
 
-sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camera, sl_orbit *orbit, sl_err *err)
+sl_status sl_camera_json_parse(const cJSON *obj, sl_camera_spec *out, sl_err *err)
 {
     static const char *const camera_keys[] = {"eye", "target", "up", "fov_y", "orbit", NULL};
     static const char *const orbit_keys[] = {"azimuth", "elevation", "distance", NULL};
@@ -80,7 +80,7 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
     sl_status st = check_keys(obj, "camera", camera_keys, err);
     if (st != SL_OK)
         return st;
-    double fov = 45.0;
+    double fov = sl_orbit_default.fov_y_deg;
     if ((st = get_number(obj, "fov_y", "camera", &fov, 0, err)) != SL_OK)
         return st;
     if (!(fov > 0.0 && fov < 180.0))
@@ -101,7 +101,8 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
             return sl_err_set(err, SL_ERR_INVALID, "camera.orbit must be an object");
         if ((st = check_keys(o, "camera.orbit", orbit_keys, err)) != SL_OK)
             return st;
-        sl_orbit r = {30.0, 20.0, 2.5, fov};
+        sl_orbit r = sl_orbit_default;
+        r.fov_y_deg = fov;
         if ((st = get_number(o, "azimuth", "camera.orbit", &r.azimuth_deg, 0, err)) != SL_OK ||
             (st = get_number(o, "elevation", "camera.orbit", &r.elevation_deg, 0, err)) != SL_OK ||
             (st = get_number(o, "distance", "camera.orbit", &r.distance, 0, err)) != SL_OK)
@@ -111,8 +112,7 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
         if (fabs(r.elevation_deg) > SL_ORBIT_MAX_ELEVATION)
             return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.elevation must be in [%g, %g] degrees, got %g",
                               -SL_ORBIT_MAX_ELEVATION, SL_ORBIT_MAX_ELEVATION, r.elevation_deg);
-        *orbit = r;
-        *is_orbit = 1;
+        *out = (sl_camera_spec){.is_orbit = 1, .orbit = r};
         return SL_OK;
     }
     sl_camera c = {.up = sl_v3(0, 1, 0), .fov_y_deg = fov};
@@ -122,9 +122,39 @@ sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camer
         return st;
     if ((st = sl_camera_validate(&c, err)) != SL_OK)
         return st;
-    *camera = c;
-    *is_orbit = 0;
+    *out = (sl_camera_spec){.is_orbit = 0, .look_at = c};
     return SL_OK;
+}
+
+static cJSON *vec3_json(sl_vec3 v)
+{
+    const double a[3] = {v.x, v.y, v.z};
+    return cJSON_CreateDoubleArray(a, 3);
+}
+
+cJSON *sl_camera_to_json(const sl_camera_spec *spec)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    double fov;
+    if (spec->is_orbit) {
+        cJSON *orbit = cJSON_AddObjectToObject(o, "orbit");
+        cJSON_AddNumberToObject(orbit, "azimuth", spec->orbit.azimuth_deg);
+        cJSON_AddNumberToObject(orbit, "elevation", spec->orbit.elevation_deg);
+        cJSON_AddNumberToObject(orbit, "distance", spec->orbit.distance);
+        fov = spec->orbit.fov_y_deg;
+    } else {
+        cJSON_AddItemToObject(o, "eye", vec3_json(spec->look_at.eye));
+        cJSON_AddItemToObject(o, "target", vec3_json(spec->look_at.target));
+        cJSON_AddItemToObject(o, "up", vec3_json(spec->look_at.up));
+        fov = spec->look_at.fov_y_deg;
+    }
+    if (!cJSON_AddNumberToObject(o, "fov_y", fov)) {
+        cJSON_Delete(o);
+        return NULL;
+    }
+    return o;
 }
 
 void sl_scene_deinit(sl_scene *s)
@@ -140,8 +170,7 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
                                              "background", "orbit_frames", "description", NULL};
     memset(s, 0, sizeof *s);
     snprintf(s->technique, sizeof s->technique, "tubes_mesh");
-    s->camera_is_orbit = 1;
-    s->orbit = (sl_orbit){30.0, 20.0, 2.5, 45.0};
+    s->camera = sl_camera_spec_default();
     s->width = s->height = 256;
     const float bg[4] = {0.1f, 0.1f, 0.12f, 1.0f};
     memcpy(s->background, bg, sizeof bg);
@@ -176,7 +205,7 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
     if (params && !cJSON_IsObject(params))
         return sl_err_set(err, SL_ERR_INVALID, "params must be an object");
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
-    if (cam && (st = sl_camera_json_parse(cam, &s->camera_is_orbit, &s->camera, &s->orbit, err)) != SL_OK)
+    if (cam && (st = sl_camera_json_parse(cam, &s->camera, err)) != SL_OK)
         return st;
     const char *size_keys[2] = {"width", "height"};
     int *size_out[2] = {&s->width, &s->height};
@@ -205,7 +234,7 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
         if (!cJSON_IsNumber(of) || of->valuedouble != floor(of->valuedouble) || of->valuedouble < 0 || of->valuedouble > 1e6)
             return sl_err_set(err, SL_ERR_INVALID, "orbit_frames must be an integer in [0, 1000000]");
         s->orbit_frames = (int)of->valuedouble;
-        if (s->orbit_frames > 0 && !s->camera_is_orbit)
+        if (s->orbit_frames > 0 && !s->camera.is_orbit)
             return sl_err_set(err, SL_ERR_INVALID, "orbit_frames turns an orbit camera, but this camera is "
                                                    "eye/target/up (use camera.orbit, or remove orbit_frames)");
     }
@@ -348,16 +377,10 @@ sl_status sl_scene_view(const sl_scene *s, const sl_dataset *ds, int frame, sl_v
     memcpy(view->background, s->background, sizeof view->background);
     view->origin = ds->origin;
     view->quality = SL_QUALITY_STILL;
-    sl_status st;
-    if (s->camera_is_orbit) {
-        sl_orbit o = s->orbit;
-        if (s->orbit_frames > 0)
-            o.azimuth_deg += 360.0 * (double)frame / (double)s->orbit_frames;
-        st = sl_camera_from_orbit(&o, ds->bounds_min, ds->bounds_max, &view->camera, err);
-    } else {
-        view->camera = s->camera;
-        st = sl_camera_validate(&view->camera, err);
-    }
+    sl_camera_spec cam = s->camera;
+    if (cam.is_orbit && s->orbit_frames > 0)
+        cam.orbit.azimuth_deg += 360.0 * (double)frame / (double)s->orbit_frames;
+    sl_status st = sl_camera_spec_resolve(&cam, ds->bounds_min, ds->bounds_max, &view->camera, err);
     if (st != SL_OK)
         return st;
     return sl_view_init(view, sl_dataset_radius(ds), err);

@@ -244,28 +244,26 @@ void sl_msg_deinit(sl_msg *msg)
     memset(msg, 0, sizeof *msg);
 }
 
-sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_err *err)
+sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_camera_spec *out, sl_err *err)
 {
-    int is_orbit = 0;
-    sl_camera cam;
-    sl_orbit orbit;
-    sl_status st = sl_camera_json_parse(camera, &is_orbit, &cam, &orbit, err);
+    sl_camera_spec spec;
+    sl_status st = sl_camera_json_parse(camera, &spec, err);
     if (st != SL_OK)
         return st;
     sl_vec3 lo = bounds ? sl_v3(bounds[0][0], bounds[0][1], bounds[0][2]) : sl_v3(-1, -1, -1);
     sl_vec3 hi = bounds ? sl_v3(bounds[1][0], bounds[1][1], bounds[1][2]) : sl_v3(1, 1, 1);
-    if (is_orbit) {
-        if (fabs(orbit.azimuth_deg) > SL_PROTO_CAMERA_MAX_AZIMUTH)
+    if (spec.is_orbit) {
+        const sl_orbit *orbit = &spec.orbit;
+        if (fabs(orbit->azimuth_deg) > SL_PROTO_CAMERA_MAX_AZIMUTH)
             return sl_err_set(err, SL_ERR_INVALID, "camera.orbit.azimuth must be in [-%g, %g] degrees, got %g",
-                              SL_PROTO_CAMERA_MAX_AZIMUTH, SL_PROTO_CAMERA_MAX_AZIMUTH, orbit.azimuth_deg);
-        if (orbit.distance > SL_PROTO_CAMERA_MAX_DISTANCE)
+                              SL_PROTO_CAMERA_MAX_AZIMUTH, SL_PROTO_CAMERA_MAX_AZIMUTH, orbit->azimuth_deg);
+        if (orbit->distance > SL_PROTO_CAMERA_MAX_DISTANCE)
             return sl_err_set(err, SL_ERR_INVALID,
                               "camera.orbit.distance must be in (0, %g] bounding-sphere radii, got %g",
-                              SL_PROTO_CAMERA_MAX_DISTANCE, orbit.distance);
-        if ((st = sl_camera_from_orbit(&orbit, lo, hi, &cam, err)) != SL_OK)
-            return st;
+                              SL_PROTO_CAMERA_MAX_DISTANCE, orbit->distance);
     } else {
-        const double v[6] = {cam.eye.x, cam.eye.y, cam.eye.z, cam.target.x, cam.target.y, cam.target.z};
+        const sl_camera *c = &spec.look_at;
+        const double v[6] = {c->eye.x, c->eye.y, c->eye.z, c->target.x, c->target.y, c->target.z};
         for (int i = 0; i < 6; i++)
             if (fabs(v[i]) > SL_PROTO_CAMERA_MAX_COORD)
                 return sl_err_set(err, SL_ERR_INVALID, "camera.%s components must be within +-%g, got %g",
@@ -273,10 +271,15 @@ sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl
     }
     sl_view view;
     memset(&view, 0, sizeof view);
-    view.camera = cam;
+    if ((st = sl_camera_spec_resolve(&spec, lo, hi, &view.camera, err)) != SL_OK)
+        return st;
     view.width = view.height = 1;
     view.origin = sl_v3_scale(sl_v3_add(lo, hi), 0.5);
-    return sl_view_init(&view, 0.5 * sl_v3_length(sl_v3_sub(hi, lo)), err);
+    if ((st = sl_view_init(&view, 0.5 * sl_v3_length(sl_v3_sub(hi, lo)), err)) != SL_OK)
+        return st;
+    if (out)
+        *out = spec;
+    return SL_OK;
 }
 
 const char *sl_msg_type_name(sl_msg_type type)
@@ -372,7 +375,7 @@ cJSON *sl_msg_state_json(const sl_msg_state *st)
     cJSON_AddStringToObject(o, "dataset", st->dataset);
     cJSON_AddStringToObject(o, "technique", st->technique);
     cJSON_AddItemToObject(o, "params", sl_params_to_json(st->params));
-    cJSON *cam = cJSON_Parse(st->camera_json);
+    cJSON *cam = sl_camera_to_json(st->camera);
     cJSON_AddItemToObject(o, "camera", cam ? cam : cJSON_CreateNull());
     cJSON_AddNumberToObject(o, "camera_seq", st->camera_seq);
     cJSON_AddNumberToObject(o, "width", st->width);
@@ -409,11 +412,15 @@ char *sl_msg_welcome_text(const sl_msg_welcome *w)
     cJSON_AddItemToObject(o, "state", w->state ? w->state : cJSON_CreateNull());
     cJSON_AddItemToObject(o, "techniques", w->techniques ? w->techniques : cJSON_CreateArray());
     cJSON_AddItemToObject(o, "datasets", w->datasets ? w->datasets : cJSON_CreateArray());
+    sl_camera_spec def = sl_camera_spec_default();
+    cJSON *cam = sl_camera_to_json(&def);
+    cJSON_AddItemToObject(o, "camera_default", cam ? cam : cJSON_CreateNull());
     cJSON *lim = cJSON_AddObjectToObject(o, "limits");
     cJSON_AddNumberToObject(lim, "max_message", SL_PROTO_MAX_MESSAGE);
     cJSON_AddNumberToObject(lim, "max_message_before_hello", SL_PROTO_MAX_HELLO);
     cJSON_AddNumberToObject(lim, "max_size", SL_PROTO_MAX_SIZE);
     cJSON_AddNumberToObject(lim, "ack_window", SL_PROTO_ACK_WINDOW);
+    cJSON_AddNumberToObject(lim, "max_elevation", SL_ORBIT_MAX_ELEVATION);
     cJSON_AddNumberToObject(lim, "max_clients", w->max_clients);
     cJSON_AddNumberToObject(lim, "grace_s", w->grace_s);
     return print_and_free(o);

@@ -18,6 +18,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_camera.h"
 #include "core/sl_params.h"
 #include "core/sl_status.h"
 
@@ -98,14 +99,15 @@ void sl_msg_deinit(sl_msg *msg);   /* safe on a zeroed or deinitialized msg */
 #define SL_PROTO_CAMERA_MAX_AZIMUTH 1e6    /* |orbit azimuth|, degrees */
 #define SL_PROTO_CAMERA_MAX_COORD 1e12     /* |eye|, |target| components, world units */
 
-/* Checks a `camera` object as the render thread will use it: the scene
- * rules (sl_camera_json_parse: finite numbers, distance > 0, elevation
+/* Parses and checks a `camera` object as the render thread will use it: the
+ * scene rules (sl_camera_json_parse: finite numbers, distance > 0, elevation
  * within SL_ORBIT_MAX_ELEVATION, fov in (0, 180)), the limits above, then
- * the resolved view (sl_camera_from_orbit, sl_view_init) against
+ * the resolved view (sl_camera_spec_resolve, sl_view_init) against
  * bounds = {lo, hi} of the session's dataset, or the cube [-1, 1]^3 when
- * bounds is NULL (not loaded yet). SL_ERR_INVALID with a message naming
- * the field path (camera.orbit.distance ...) and its limit. */
-sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_err *err);
+ * bounds is NULL (not loaded yet). On success *out (when not NULL) receives
+ * the parsed camera; on failure SL_ERR_INVALID with a message naming the
+ * field path (camera.orbit.distance ...) and its limit, *out unchanged. */
+sl_status sl_msg_camera_check(const cJSON *camera, const double (*bounds)[3], sl_camera_spec *out, sl_err *err);
 
 const char *sl_msg_type_name(sl_msg_type type);
 const char *sl_camera_phase_name(sl_camera_phase phase);
@@ -150,7 +152,7 @@ typedef struct sl_msg_state {
     uint32_t version;
     const char *dataset, *technique;
     const sl_params *params;
-    const char *camera_json;       /* a validated camera object */
+    const sl_camera_spec *camera;  /* a checked camera (sl_msg_camera_check) */
     uint32_t camera_seq;
     int width, height;
     const float *background;       /* 4 floats */
@@ -163,7 +165,9 @@ cJSON *sl_msg_state_json(const sl_msg_state *st);
 /* {"type":"state","version":v,"patch":patch (consumed)} */
 char *sl_msg_state_text(uint32_t version, cJSON *patch);
 
-/* welcome: what a client needs after hello. */
+/* welcome: what a client needs after hello. It also carries the default
+ * camera (camera_default) and limits.max_elevation from core/sl_camera.h,
+ * so the page holds no camera numbers of its own. */
 typedef struct sl_msg_welcome {
     const char *session, *token;
     int client;

@@ -22,16 +22,14 @@ typedef struct sl_scene {
     cJSON *dataset;            /* owned copy: string (name or path) or generator object */
     char technique[64];
     cJSON *params;             /* owned copy of the params object (may be NULL) */
-    int camera_is_orbit;
-    sl_camera camera;          /* when !camera_is_orbit */
-    sl_orbit orbit;            /* when camera_is_orbit */
+    sl_camera_spec camera;
     int width, height;
     float background[4];
     int orbit_frames;          /* 0: every frame uses the camera as given */
 } sl_scene;
 
-/* Parses a scene document. Defaults: technique "tubes_mesh", orbit
- * {azimuth 30, elevation 20, distance 2.5}, fov_y 45, 256x256, background
+/* Parses a scene document. Defaults: technique "tubes_mesh", the camera
+ * sl_camera_spec_default() (core/sl_camera.h), 256x256, background
  * [0.1,0.1,0.12,1]. On failure *scene is left deinitialized. */
 sl_status sl_scene_parse(const char *json_text, sl_scene *scene, sl_err *err);
 sl_status sl_scene_from_json(const cJSON *root, sl_scene *scene, sl_err *err);
@@ -46,8 +44,15 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
  * relative file paths are looked up. */
 sl_status sl_scene_open_dataset(const sl_scene *scene, const char *data_dir, sl_dataset **out, sl_err *err);
 
-/* Parses a camera object (either form) — shared with the wire protocol. */
-sl_status sl_camera_json_parse(const cJSON *obj, int *is_orbit, sl_camera *camera, sl_orbit *orbit, sl_err *err);
+/* Parses a camera object (either form) — shared with the wire protocol.
+ * Keys it leaves out take sl_orbit_default's values (up: +y). On failure
+ * (SL_ERR_INVALID naming the field) *out is unchanged. */
+sl_status sl_camera_json_parse(const cJSON *obj, sl_camera_spec *out, sl_err *err);
+/* The complete camera object of spec (every key, defaults written out),
+ * which sl_camera_json_parse reads back to the same numbers to within
+ * cJSON's printing (15 digits when that is within DBL_EPSILON); NULL when
+ * out of memory. Free with cJSON_Delete. */
+cJSON *sl_camera_to_json(const sl_camera_spec *spec);
 
 /* The view of frame `frame` (orbit_frames advance the azimuth by
  * 360/orbit_frames per frame) for a dataset's bounds. */

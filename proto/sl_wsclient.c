@@ -17,8 +17,9 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "core/sl_clock.h"
 
 #define SL_WSCLIENT_MAX_MESSAGE (64u * 1024u * 1024u)
 
@@ -31,13 +32,6 @@ struct sl_wsclient {
     uint64_t rng;
     int timed_out;
 };
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
 
 static sl_status send_all(sl_wsclient *c, const uint8_t *p, size_t n, sl_err *err)
 {
@@ -63,7 +57,7 @@ static sl_status fill(sl_wsclient *c, size_t need, double deadline, sl_err *err)
         c->rpos = 0;
     }
     while (c->rlen - c->rpos < need) {
-        int wait = (int)(deadline - now_ms());
+        int wait = (int)(deadline - sl_clock_ms());
         if (wait <= 0) {
             c->timed_out = 1;
             return sl_err_set(err, SL_ERR_IO, "websocket receive timeout");
@@ -162,7 +156,7 @@ sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_
     /* Read the response head byte by byte until the blank line (bounded). */
     char head[4096];
     size_t hl = 0;
-    double deadline = now_ms() + timeout_ms;
+    double deadline = sl_clock_ms() + timeout_ms;
     while (hl < 4 || memcmp(head + hl - 4, "\r\n\r\n", 4) != 0) {
         if (hl + 1 >= sizeof head) {
             sl_wsclient_destroy(c);
@@ -277,7 +271,7 @@ int sl_wsclient_timed_out(const sl_wsclient *c)
 sl_status sl_wsclient_recv(sl_wsclient *c, int timeout_ms, sl_ws_kind *kind, const uint8_t **data,
                            size_t *size, int *close_code, sl_err *err)
 {
-    double deadline = now_ms() + timeout_ms;
+    double deadline = sl_clock_ms() + timeout_ms;
     c->timed_out = 0;
     c->msg_size = 0;
     int msg_opcode = 0;
@@ -287,7 +281,7 @@ sl_status sl_wsclient_recv(sl_wsclient *c, int timeout_ms, sl_ws_kind *kind, con
     sl_status first = fill(c, 1, deadline, err);
     if (first)
         return first;
-    deadline = now_ms() + 10000.0;
+    deadline = sl_clock_ms() + 10000.0;
     for (;;) {
         uint8_t h[2];
         sl_status st = read_bytes(c, h, 2, deadline, err);

@@ -16,7 +16,7 @@
 #include <libwebsockets.h>
 #include <turbojpeg.h>
 
-#include "gpu/sl_gpu.h"
+#include "core/sl_clock.h"
 #include "image/sl_image.h"
 
 struct sl_encoder {
@@ -81,7 +81,7 @@ sl_status sl_encoder_jpeg(sl_encoder *e, const uint8_t *rgba_bottom_up, int widt
     sl_frame_buf *f = sl_frame_buf_create(SL_FRAME_HEADER_SIZE + bound);
     if (!f)
         return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate a %lu-byte frame", bound);
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     unsigned char *dst = f->data + SL_FRAME_HEADER_SIZE;
     unsigned long size = bound;
     if (tjCompress2(e->tj, rgba_bottom_up, width, 0, height, TJPF_RGBA, &dst, &size, subsamp, quality,
@@ -90,7 +90,7 @@ sl_status sl_encoder_jpeg(sl_encoder *e, const uint8_t *rgba_bottom_up, int widt
         return sl_err_set(err, SL_ERR_INVALID, "JPEG encode of %dx%d failed: %s", width, height,
                           tjGetErrorStr2(e->tj));
     }
-    *encode_ms = sl_now_ms() - t0;
+    *encode_ms = sl_clock_ms() - t0;
     f->header.kind = SL_FRAME_JPEG;
     f->header.width = (uint16_t)width;
     f->header.height = (uint16_t)height;
@@ -107,7 +107,7 @@ sl_status sl_encoder_png(const uint8_t *rgba_top_down, int width, int height, sl
                          double *encode_ms, sl_err *err)
 {
     *out = NULL;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     uint8_t *png = NULL;
     size_t png_size = 0;
     sl_status st = sl_png_encode(rgba_top_down, width, height, &png, &png_size, err);
@@ -120,7 +120,7 @@ sl_status sl_encoder_png(const uint8_t *rgba_top_down, int width, int height, sl
     }
     memcpy(f->data + SL_FRAME_HEADER_SIZE, png, png_size);
     free(png);
-    *encode_ms = sl_now_ms() - t0;
+    *encode_ms = sl_clock_ms() - t0;
     f->header.kind = SL_FRAME_PNG;
     f->header.width = (uint16_t)width;
     f->header.height = (uint16_t)height;

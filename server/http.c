@@ -31,7 +31,7 @@ char *sl_http_healthz(sl_server *srv, int *status)
     int ok = srv->render_ready > 0 && !srv->stop;
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "status", ok ? "ok" : "unavailable");
-    cJSON_AddNumberToObject(o, "uptime_s", (sl_server_now_ms() - srv->start_ms) / 1000.0);
+    cJSON_AddNumberToObject(o, "uptime_s", (sl_clock_ms() - srv->start_ms) / 1000.0);
     cJSON_AddNumberToObject(o, "sessions", srv->session_count);
     cJSON_AddNumberToObject(o, "clients", srv->client_count);
     cJSON_AddStringToObject(o, "renderer", srv->gpu_renderer);

@@ -26,7 +26,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include "core/sl_technique.h"
 #include "sl_params_json.h"
@@ -250,11 +249,11 @@ int main(int argc, char **argv)
     if (!srv)
         return 1;
     srv->cfg = cfg;
-    srv->start_ms = sl_server_now_ms();
+    srv->start_ms = sl_clock_ms();
     pthread_mutex_init(&srv->lock, NULL);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
-    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_condattr_setclock(&ca, SL_CLOCK_ID); /* sl_clock_deadline's clock (render.c) */
     pthread_cond_init(&srv->wake, &ca);
     pthread_condattr_destroy(&ca);
     sl_err err = {0};

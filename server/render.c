@@ -27,10 +27,11 @@
 
 #include <libwebsockets.h>
 
+#include "core/sl_camera.h"
+#include "core/sl_clock.h"
 #include "core/sl_technique.h"
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
-#include "sl_scene.h"
 
 enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT };
 
@@ -158,16 +159,9 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return sl_err_set(err, SL_ERR_INVALID, "technique \"%s\" is not in this build", st->technique);
     if ((rc = sl_pipeline_set_technique(s->pipeline, t, &st->params, err)) != SL_OK)
         return rc;
-    cJSON *cam = cJSON_Parse(st->camera_json);
     sl_view view;
     memset(&view, 0, sizeof view);
-    int is_orbit = 0;
-    sl_orbit orbit;
-    rc = sl_camera_json_parse(cam, &is_orbit, &view.camera, &orbit, err);
-    cJSON_Delete(cam);
-    if (rc)
-        return rc;
-    if (is_orbit && (rc = sl_camera_from_orbit(&orbit, ds->bounds_min, ds->bounds_max, &view.camera, err)))
+    if ((rc = sl_camera_spec_resolve(&st->camera, ds->bounds_min, ds->bounds_max, &view.camera, err)) != SL_OK)
         return rc;
     int w = st->width, h = st->height;
     if (scale < 1) {
@@ -183,7 +177,7 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
     view.origin = ds->origin;
     if ((rc = sl_view_init(&view, sl_dataset_radius(ds), err)) != SL_OK)
         return rc;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_frame_stats stats;
     if ((rc = sl_pipeline_render(s->pipeline, &view, 1, &stats, err)) != SL_OK)
         return rc;
@@ -191,7 +185,7 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
         return rc;
     *w_out = w;
     *h_out = h;
-    *render_ms = sl_now_ms() - t0;
+    *render_ms = sl_clock_ms() - t0;
     *prepare_ms = stats.prepare_ms;
     return SL_OK;
 }
@@ -225,7 +219,7 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     sl_err err = {0};
     int w = 0, h = 0, step = 0;
     double render_ms = 0, prepare_ms = 0, encode_ms = 0;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_frame_buf *f = NULL;
     sl_iscale_sync(&s->iscale, scene_key(st), st->stream.interactive_scale);
     double scale = interactive ? sl_iscale_choose(&s->iscale, &st->stream, &step) : 1.0;
@@ -233,10 +227,10 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
         report_error(ctx->srv, s, st, &err);
         return;
     }
-    double t_read = sl_now_ms();
+    double t_read = sl_clock_ms();
     sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 0);
     test_delay(ctx->srv, st, w, h);
-    double t_done = sl_now_ms();
+    double t_done = sl_clock_ms();
     double cost_ms = render_ms - prepare_ms + (t_done - t_read);
     render_ms = t_done - t0;
     int quality = interactive ? st->stream.interactive_quality : st->stream.still_quality;
@@ -335,7 +329,7 @@ static void *render_main(void *arg)
     sl_session_state *copy = malloc(sizeof *copy);
     while (!srv->stop && copy) {
         reap(srv);
-        double now = sl_server_now_ms();
+        double now = sl_clock_ms();
         double deadline = now + 1000.0;
         enum job_kind kind = JOB_NONE;
         sl_session *s = pick_job(srv, &ctx.rr, &kind, now, &deadline);
@@ -343,11 +337,7 @@ static void *render_main(void *arg)
             double wait = deadline - now;
             if (wait < 1)
                 wait = 1;
-            struct timespec ts;
-            clock_gettime(CLOCK_MONOTONIC, &ts);
-            long long ns = ts.tv_nsec + (long long)(wait * 1e6);
-            ts.tv_sec += (time_t)(ns / 1000000000LL);
-            ts.tv_nsec = (long)(ns % 1000000000LL);
+            struct timespec ts = sl_clock_deadline(wait);
             pthread_cond_timedwait(&srv->wake, &srv->lock, &ts);
             continue;
         }

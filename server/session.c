@@ -30,14 +30,12 @@
 #include "sl_params_json.h"
 #include "sl_scene.h"
 
-#define DEFAULT_CAMERA "{\"orbit\":{\"azimuth\":30,\"elevation\":20,\"distance\":2.5},\"fov_y\":45}"
-
 static void random_hex(char *out, int bytes)
 {
     unsigned char buf[32];
     if (getrandom(buf, (size_t)bytes, 0) != bytes) {
         /* getrandom on Linux does not fail for <= 256 bytes once seeded; mix the clock in as a fallback. */
-        double t = sl_server_now_ms();
+        double t = sl_clock_ms();
         for (int i = 0; i < bytes; i++)
             buf[i] = (unsigned char)((long long)(t * 1000.0) >> (i % 8) ^ (unsigned)rand());
     }
@@ -102,7 +100,7 @@ static cJSON *state_json(const sl_session *s)
 {
     const sl_session_state *st = &s->state;
     sl_msg_state m = {.version = st->version, .dataset = st->dataset, .technique = st->technique,
-                      .params = &st->params, .camera_json = st->camera_json, .camera_seq = st->camera_seq,
+                      .params = &st->params, .camera = &st->camera, .camera_seq = st->camera_seq,
                       .width = st->width, .height = st->height, .background = st->background, .stream = &st->stream,
                       .controller = s->controller, .bounds = s->bounds};
     return sl_msg_state_json(&m);
@@ -254,12 +252,12 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
         return NULL;
     }
     st->version = 1;
-    snprintf(st->camera_json, sizeof st->camera_json, "%s", DEFAULT_CAMERA);
+    st->camera = sl_camera_spec_default();
     st->width = width > 0 ? width : 640;
     st->height = height > 0 ? height : 480;
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
     st->stream = SL_STREAM_DEFAULTS;
-    s->empty_since_ms = sl_server_now_ms();
+    s->empty_since_ms = sl_clock_ms();
     pthread_mutex_lock(&srv->lock);
     s->next = srv->sessions;
     srv->sessions = s;
@@ -331,11 +329,11 @@ static int require_control(sl_server *srv, sl_client *c, const char *what)
     return 0;
 }
 
-/* Validates a camera against the session's dataset bounds (when known) and
- * copies its compact text to out; on failure sends bad_field/camera. The
+/* Parses a camera and checks it against the session's dataset bounds (when
+ * known) into *out; on failure sends bad_field/camera and leaves *out. The
  * same check the render thread's resolution makes, so an accepted camera
- * renders. */
-static int parse_camera(sl_server *srv, sl_client *c, const cJSON *cam, char out[SL_CAMERA_JSON_MAX])
+ * renders. The camera is parsed here once; state keeps the typed camera. */
+static int parse_camera(sl_server *srv, sl_client *c, const cJSON *cam, sl_camera_spec *out)
 {
     sl_err err = {0};
     double bounds[2][3];
@@ -346,18 +344,10 @@ static int parse_camera(sl_server *srv, sl_client *c, const cJSON *cam, char out
             have_bounds = cJSON_IsNumber(v);
             bounds[i][k] = have_bounds ? v->valuedouble : 0.0;
         }
-    if (sl_msg_camera_check(cam, have_bounds ? (const double (*)[3])bounds : NULL, &err) != SL_OK) {
+    if (sl_msg_camera_check(cam, have_bounds ? (const double (*)[3])bounds : NULL, out, &err) != SL_OK) {
         send_error(srv, c, "bad_field", err.message, "camera");
         return 0;
     }
-    char *text = cJSON_PrintUnformatted(cam);
-    if (!text || strlen(text) >= SL_CAMERA_JSON_MAX) {
-        free(text);
-        send_error(srv, c, "bad_field", "camera object is longer than 1024 bytes", "camera");
-        return 0;
-    }
-    memcpy(out, text, strlen(text) + 1);
-    free(text);
     return 1;
 }
 
@@ -433,7 +423,7 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
     }
     if (params && !apply_params(srv, c, &next.params, params))
         return;
-    if (camera && !parse_camera(srv, c, camera, next.camera_json))
+    if (camera && !parse_camera(srv, c, camera, &next.camera))
         return;
     next.phase = SL_PHASE_NONE;
     if (strcmp(next.dataset, s->state.dataset) != 0) {
@@ -519,18 +509,18 @@ static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
 static void on_camera(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
-    char cam[SL_CAMERA_JSON_MAX];
-    if (!parse_camera(srv, c, m->camera, cam))
+    sl_camera_spec cam;
+    if (!parse_camera(srv, c, m->camera, &cam))
         return;
     pthread_mutex_lock(&srv->lock);
-    memcpy(s->state.camera_json, cam, sizeof cam);
+    s->state.camera = cam;
     s->state.camera_seq = (uint32_t)m->seq;
     s->state.phase = m->phase;
-    s->state.camera_ms = sl_server_now_ms();
+    s->state.camera_ms = sl_clock_ms();
     state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
-    cJSON_AddItemToObject(p, "camera", cJSON_Parse(cam));
+    cJSON_AddItemToObject(p, "camera", sl_camera_to_json(&cam));
     cJSON_AddNumberToObject(p, "camera_seq", (double)m->seq);
     broadcast_patch(s, p);
 }
@@ -639,9 +629,12 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
         if (!require_control(srv, c, "save_view"))
             break;
         char *params = print_and_free(sl_params_to_json(&s->state.params));
-        sl_status st = sl_catalog_save_view(srv->db, m.name, s->state.dataset, s->state.technique,
-                                            params ? params : "{}", s->state.camera_json, &err);
+        char *camera = print_and_free(sl_camera_to_json(&s->state.camera));
+        sl_status st = camera ? sl_catalog_save_view(srv->db, m.name, s->state.dataset, s->state.technique,
+                                                     params ? params : "{}", camera, &err)
+                              : sl_err_set(&err, SL_ERR_NOMEM, "out of memory writing the view's camera");
         free(params);
+        free(camera);
         if (st) {
             send_error(srv, c, st == SL_ERR_LIMIT ? "limit" : "internal", err.message, "name");
         } else {
@@ -712,7 +705,7 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
         if (s->controller == c->id)
             pass_control(s, c->id);
         if (s->client_count == 0)
-            s->empty_since_ms = sl_server_now_ms();
+            s->empty_since_ms = sl_clock_ms();
         pthread_mutex_lock(&srv->lock);
         for (int i = 0; i < s->snap_req_count; i++)
             if (s->snap_req[i] == c->id)
@@ -902,7 +895,7 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
 
 void sl_sessions_sweep(sl_server *srv)
 {
-    double now = sl_server_now_ms();
+    double now = sl_clock_ms();
     /* One expired session per pass under the lock; its catalog row is deleted
      * after unlocking, so a WAL commit never stalls the render thread. */
     for (;;) {

@@ -10,7 +10,7 @@
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
- *   clock.c    monotonic milliseconds, the one time source (any thread)
+ * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
  * render thread owns every GL object. They share only the fields marked
@@ -36,6 +36,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_clock.h"
 #include "core/sl_params.h"
 #include "core/sl_status.h"
 #include "sl_protocol.h"
@@ -49,7 +50,6 @@ typedef struct sl_dataset sl_dataset;
 #define SL_SERVER_MAX_DATA_DIRS 8
 #define SL_CLIENT_MAX_TEXT 32          /* queued replies to the client's own requests; more closes it */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
-#define SL_CAMERA_JSON_MAX 1024
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
 
@@ -111,7 +111,7 @@ typedef struct sl_session_state {
     int dataset_kind;
     char technique[SL_PROTO_NAME_MAX];
     sl_params params;
-    char camera_json[SL_CAMERA_JSON_MAX];/* validated camera object */
+    sl_camera_spec camera;               /* checked on arrival (sl_msg_camera_check) */
     uint32_t camera_seq;
     sl_camera_phase phase;
     double camera_ms;                    /* time of the last camera message */
@@ -325,8 +325,5 @@ char *sl_http_metrics(sl_server *srv);
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
 void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted);
 void sl_ws_destroy(sl_server *srv);
-
-/* clock.c */
-double sl_server_now_ms(void);
 
 #endif

@@ -28,6 +28,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/sl_clock.h"
 #include "data/sl_load.h"
 #include "image/sl_image.h"
 #include "pipeline/sl_pipeline.h"
@@ -352,14 +353,14 @@ int main(int argc, char **argv)
     snprintf(scene_dir, sizeof scene_dir, "%s", o.scene);
     const char *data_dir = o.data_dir ? o.data_dir : dirname(scene_dir);
     sl_dataset *ds = NULL;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     if ((st = sl_scene_open_dataset(&scene, data_dir, &ds, &err)) != SL_OK) {
         fprintf(stderr, "sightline-render: dataset: %s\n", err.message);
         sl_gpu_destroy(gpu);
         sl_scene_deinit(&scene);
         return EXIT_BAD_INPUT; /* loaders never touch the GPU: an unsupported file variant is bad input */
     }
-    double load_ms = sl_now_ms() - t0;
+    double load_ms = sl_clock_ms() - t0;
 
     const sl_technique *tech = sl_technique_find(scene.technique);
     sl_params params;

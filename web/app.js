@@ -44,6 +44,7 @@ window.sightline = {
   get techniques() { return app.techniques; },
   get clientId() { return app.clientId; },
   get cameraSeq() { return app.seq; },
+  get cameraLimits() { return { maxElevation: camera.maxElevation, defaults: camera.defaults }; },
   get stateVersion() { return app.stateVersion; },
   get connected() { return conn.ws?.readyState === WebSocket.OPEN; },
 };
@@ -225,6 +226,7 @@ conn.addEventListener('message', (ev) => {
       app.datasets = msg.datasets || [];
       app.state = null;
       params.schemaKey = '';
+      camera.configure(msg.camera_default, msg.limits.max_elevation);
       applyState(msg.state);
       app.stateVersion = msg.state.version;
       fillPickers();

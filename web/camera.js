@@ -3,6 +3,9 @@
 // The camera is an orbit about the dataset's bounds centre (the same formula
 // as renderer/core/sl_camera.c); once the bounds are known and the user pans,
 // it is sent as eye/target/up so the target can leave the centre.
+// It holds no camera numbers of its own: the default camera and the
+// elevation limit come from the server's welcome (configure), and input is
+// ignored until then.
 
 const DEG = Math.PI / 180;
 
@@ -10,8 +13,10 @@ export class CameraControl {
   constructor(canvas, send) {
     this.canvas = canvas;
     this.send = send;              // (phase, cameraObject) => void
-    this.orbit = { azimuth: 30, elevation: 20, distance: 2.5 };
-    this.fov = 45;
+    this.defaults = null;          // welcome.camera_default: {orbit: {azimuth, elevation, distance}, fov_y}
+    this.maxElevation = 0;         // welcome.limits.max_elevation, degrees
+    this.orbit = null;             // {azimuth, elevation, distance}; null until configured
+    this.fov = 0;
     this.pan = [0, 0, 0];          // world offset of the target from the bounds centre
     this.bounds = null;            // [[x,y,z],[x,y,z]]
     this.enabled = true;
@@ -24,13 +29,24 @@ export class CameraControl {
     this.attach();
   }
 
+  // Takes the server's default camera and elevation limit (from welcome).
+  configure(cameraDefault, maxElevation) {
+    this.defaults = cameraDefault;
+    this.maxElevation = maxElevation;
+    if (!this.orbit) {
+      this.orbit = { ...cameraDefault.orbit };
+      this.fov = cameraDefault.fov_y;
+    }
+  }
+
   // Adopts a camera object from the session state (when someone else moved it).
+  // The server sends complete cameras; a key it left out keeps the default.
   adopt(cam, bounds) {
     if (bounds) this.bounds = bounds;
-    if (!cam || this.dragging) return;
+    if (!cam || this.dragging || !this.defaults) return;
     if (cam.fov_y) this.fov = cam.fov_y;
     if (cam.orbit) {
-      this.orbit = { azimuth: cam.orbit.azimuth ?? 30, elevation: cam.orbit.elevation ?? 20, distance: cam.orbit.distance ?? 2.5 };
+      this.orbit = { ...this.defaults.orbit, ...cam.orbit };
       this.pan = [0, 0, 0];
     } else if (cam.eye && cam.target && this.bounds) {
       const c = this.centre(), r = this.radius();
@@ -97,7 +113,8 @@ export class CameraControl {
 
   rotate(dx, dy) {
     this.orbit.azimuth -= dx * 0.4;
-    this.orbit.elevation = Math.max(-89, Math.min(89, this.orbit.elevation + dy * 0.4));
+    const lim = this.maxElevation;
+    this.orbit.elevation = Math.max(-lim, Math.min(lim, this.orbit.elevation + dy * 0.4));
   }
 
   panBy(dx, dy) {
@@ -119,14 +136,14 @@ export class CameraControl {
     cv.style.touchAction = 'none';
     cv.addEventListener('contextmenu', (e) => e.preventDefault());
     cv.addEventListener('pointerdown', (e) => {
-      if (!this.enabled) return;
+      if (!this.enabled || !this.orbit) return;
       cv.setPointerCapture(e.pointerId);
       this.pointers.set(e.pointerId, { x: e.clientX, y: e.clientY, button: e.button, shift: e.shiftKey });
       if (this.pointers.size === 1) { this.dragging = true; this.emit('start'); }
     });
     cv.addEventListener('pointermove', (e) => {
       const p = this.pointers.get(e.pointerId);
-      if (!p || !this.enabled) return;
+      if (!p || !this.enabled || !this.orbit) return;
       const dx = e.clientX - p.x, dy = e.clientY - p.y;
       if (this.pointers.size === 2) {
         const [a, b] = [...this.pointers.values()];
@@ -148,7 +165,7 @@ export class CameraControl {
     cv.addEventListener('pointerup', up);
     cv.addEventListener('pointercancel', up);
     cv.addEventListener('wheel', (e) => {
-      if (!this.enabled) return;
+      if (!this.enabled || !this.orbit) return;
       e.preventDefault();
       this.zoom(Math.exp(e.deltaY * 0.001));
       this.emit('move');

@@ -21,7 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "gpu/sl_gpu.h"
+#include "core/sl_clock.h"
 
 #ifndef SIGHTLINE_SOURCE_DIR
 #define SIGHTLINE_SOURCE_DIR "."
@@ -188,7 +188,7 @@ static void json_string(const cJSON *o, const char *key, char *out, size_t size)
 static void run_peer(const char *cmd, const sl_bench_tube_peer_desc *d, const char *label, sl_bench_peer_result *r)
 {
     fflush(stdout);
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     FILE *p = popen(cmd, "r");
     if (!p) {
         set_reason(r, "cannot start the peer");
@@ -203,7 +203,7 @@ static void run_peer(const char *cmd, const sl_bench_tube_peer_desc *d, const ch
             snprintf(last, sizeof last, "%.500s", line);
     }
     int status = pclose(p);
-    r->seconds = (sl_now_ms() - t0) / 1000.0;
+    r->seconds = (sl_clock_ms() - t0) / 1000.0;
     cJSON *root = json[0] ? cJSON_Parse(json) : NULL;
     if (!root) {
         char reason[700];

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/sl_clock.h"
 #include "gpu/sl_gpu.h"
 
 static int cmp_double(const void *a, const void *b)
@@ -123,12 +124,12 @@ sl_status sl_bench_time_frames(sl_pipeline *p, const sl_technique *t, const sl_p
             (st = sl_view_init(&view, sl_dataset_radius(ds), err)) != SL_OK)
             break;
         sl_frame_stats stats;
-        double t0 = sl_now_ms();
+        double t0 = sl_clock_ms();
         if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
             break;
         sl_pipeline_read_rgba(p, rgba, 0);
         glFinish();
-        double ms = sl_now_ms() - t0 - (stats.prepared ? stats.prepare_ms : 0.0);
+        double ms = sl_clock_ms() - t0 - (stats.prepared ? stats.prepare_ms : 0.0);
         if (f < 0) {
             out->prepare_ms = stats.prepare_ms;
             continue;

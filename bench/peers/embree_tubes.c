@@ -25,8 +25,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "core/sl_clock.h"
 #include "data/sl_load.h"
 #include "image/sl_image.h"
 
@@ -93,13 +93,6 @@ static int fail(const char *fmt, ...)
     free(s);
     cJSON_Delete(o);
     return 1;
-}
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
 static void on_device_error(void *user, enum RTCError code, const char *str)
@@ -513,7 +506,7 @@ static double render_frame(frame_job *job, int threads, char *msg, size_t size)
 {
     pthread_t tid[MAX_THREADS];
     int started = 0;
-    double t0 = now_ms();
+    double t0 = sl_clock_ms();
     atomic_store(&job->next_tile, 0);
     for (; started < threads - 1; started++)
         if (pthread_create(&tid[started], NULL, trace_tiles, job) != 0)
@@ -521,7 +514,7 @@ static double render_frame(frame_job *job, int threads, char *msg, size_t size)
     trace_tiles(job);
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
-    double ms = now_ms() - t0;
+    double ms = sl_clock_ms() - t0;
     if (started < threads - 1) {
         snprintf(msg, size, "could start only %d of %d worker threads", started, threads - 1);
         return -1.0;
@@ -670,7 +663,7 @@ int main(int argc, char **argv)
         goto done;
     }
 
-    double t0 = now_ms();
+    double t0 = sl_clock_ms();
     scene = rtcNewScene(device);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE);
     float *vert = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
@@ -689,7 +682,7 @@ int main(int argc, char **argv)
     }
     if (geom)
         rtcReleaseGeometry(geom);
-    double build_ms = now_ms() - t0;
+    double build_ms = sl_clock_ms() - t0;
     if (atomic_load(&errors.count) || !scene || !geom || !vert || !tangent || !index) {
         rc = fail("building the scene: %s", atomic_load(&errors.count) ? errors.first : "Embree returned NULL");
         goto done;

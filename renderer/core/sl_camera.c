@@ -4,6 +4,13 @@
 
 #include <math.h>
 
+const sl_orbit sl_orbit_default = {.azimuth_deg = 30.0, .elevation_deg = 20.0, .distance = 2.5, .fov_y_deg = 45.0};
+
+sl_camera_spec sl_camera_spec_default(void)
+{
+    return (sl_camera_spec){.is_orbit = 1, .orbit = sl_orbit_default};
+}
+
 sl_status sl_camera_from_orbit(const sl_orbit *orbit, sl_vec3 lo, sl_vec3 hi,
                                sl_camera *out, sl_err *err)
 {
@@ -51,6 +58,15 @@ sl_status sl_camera_validate(const sl_camera *c, sl_err *err)
     if (!(sl_v3_length(r) > 1e-9))
         return sl_err_set(err, SL_ERR_INVALID, "camera.up must not be parallel to the view direction");
     return SL_OK;
+}
+
+sl_status sl_camera_spec_resolve(const sl_camera_spec *spec, sl_vec3 lo, sl_vec3 hi, sl_camera *out,
+                                 sl_err *err)
+{
+    if (spec->is_orbit)
+        return sl_camera_from_orbit(&spec->orbit, lo, hi, out, err);
+    *out = spec->look_at;
+    return sl_camera_validate(out, err);
 }
 
 sl_status sl_view_init(sl_view *v, double scene_radius, sl_err *err)

@@ -15,8 +15,8 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
+#include "../core/sl_clock.h"
 #include "gen_family.h"
 
 static const sl_gen_family *const families[] = {
@@ -231,8 +231,7 @@ sl_status sl_generate_json(const char *json_text, sl_dataset **out, sl_err *err)
     *out = NULL;
     if (!json_text)
         return sl_err_set(err, SL_ERR_INVALID, "generator call is NULL");
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sl_clock_ms();
     const char *at = NULL; /* cJSON's per-call error position (its global one is not thread-safe) */
     cJSON *root = cJSON_ParseWithOpts(json_text, &at, 1);
     if (!root) {
@@ -245,7 +244,6 @@ sl_status sl_generate_json(const char *json_text, sl_dataset **out, sl_err *err)
         *out = NULL;
         return st;
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    (*out)->load_ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
+    (*out)->load_ms = sl_clock_ms() - t0;
     return SL_OK;
 }

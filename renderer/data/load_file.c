@@ -17,7 +17,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include "../core/sl_clock.h"
 
 /* A .json dataset is either explicit Hermite line data or a raw volume's sidecar. */
 static sl_status load_json_dataset(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err)
@@ -153,8 +154,7 @@ sl_status sl_load_file(const char *path, sl_dataset **out, sl_err *err)
     if (!entry)
         return sl_err_set(err, SL_ERR_UNSUPPORTED, "%s: unknown file extension; supported: " SL_SUPPORTED_EXTENSIONS,
                           path);
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sl_clock_ms();
     uint8_t *data = NULL;
     size_t size = 0;
     sl_status st = read_content(path, entry, &data, &size, err);
@@ -168,8 +168,7 @@ sl_status sl_load_file(const char *path, sl_dataset **out, sl_err *err)
         return st;
     }
     sl_load_base_name(path, "dataset", ds->name, sizeof ds->name);
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    ds->load_ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6;
+    ds->load_ms = sl_clock_ms() - t0;
     *out = ds;
     return SL_OK;
 }

@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 extern const sl_embedded_file sl_embedded_files[];
 extern const int sl_embedded_file_count;
@@ -243,11 +242,4 @@ sl_status sl_gl_program_create(const sl_program_desc *d, GLuint *program, sl_err
         glObjectLabel(GL_PROGRAM, p, -1, d->label);
     *program = p;
     return SL_OK;
-}
-
-double sl_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }

@@ -123,7 +123,4 @@ double sl_gpu_timer_end_ms(sl_gpu_timer *t);
 struct sl_view;
 void sl_camera_ubo_update(GLuint *buffer, const struct sl_view *view);
 
-/* Wall clock in milliseconds (monotonic). */
-double sl_now_ms(void);
-
 #endif

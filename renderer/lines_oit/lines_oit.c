@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
@@ -90,13 +91,13 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         return st;
     }
     sl_tube_mesh mesh;
-    double t_build = sl_now_ms();
+    double t_build = sl_clock_ms();
     st = sl_tube_mesh_build(&ds->lines, sl_params_int(params, "sides"), 0, &mesh, err);
     if (st != SL_OK) {
         free(s);
         return st;
     }
-    s->prep.preprocess_ms = sl_now_ms() - t_build;
+    s->prep.preprocess_ms = sl_clock_ms() - t_build;
     st = sl_gl_program_create(&(sl_program_desc){.vertex = "lines_oit/lines_oit.vert.glsl",
                                                  .fragment = "lines_oit/lines_oit_collect.frag.glsl",
                                                  .label = "lines_oit_collect"},
@@ -111,7 +112,7 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         lines_oit_release(s);
         return st;
     }
-    double t_upload = sl_now_ms();
+    double t_upload = sl_clock_ms();
     glCreateBuffers(1, &s->vbo);
     glNamedBufferStorage(s->vbo, (GLsizeiptr)((mesh.vertex_count ? mesh.vertex_count : 1) * sizeof(sl_tube_vertex)),
                          mesh.vertex_count ? mesh.vertices : NULL, 0);
@@ -150,7 +151,7 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
                     (ds->lines.vertex_count + 1) * sizeof(float);
     sl_tube_mesh_deinit(&mesh);
     glFinish();
-    s->prep.upload_ms = sl_now_ms() - t_upload;
+    s->prep.upload_ms = sl_clock_ms() - t_upload;
     *out = s;
     return SL_OK;
 }

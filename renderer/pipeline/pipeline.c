@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/sl_clock.h"
+
 struct sl_pipeline {
     sl_gpu *gpu;                  /* borrowed */
     sl_dataset *dataset;          /* owned */
@@ -90,14 +92,14 @@ sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
         release_state(p);
     if (p->stale || !p->state) {
         release_state(p);
-        double t0 = sl_now_ms();
+        double t0 = sl_clock_ms();
         sl_status st = p->technique->prepare(p->gpu, p->dataset, &p->params, &p->state, err);
         if (st != SL_OK) {
             p->state = NULL;
             return st;
         }
         glFinish();
-        stats->prepare_ms = sl_now_ms() - t0;
+        stats->prepare_ms = sl_clock_ms() - t0;
         stats->prepared = 1;
         if (p->technique->prepare_stats) {
             p->technique->prepare_stats(p->state, &stats->prepare);
@@ -113,14 +115,14 @@ sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
         if (st != SL_OK)
             return st;
     }
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_target_begin(&p->target, view->background);
     sl_gpu_timer_begin(&p->timer);
     sl_status st = p->technique->render(p->state, view, &p->params, &p->target, &stats->render, err);
     stats->gpu_ms = sl_gpu_timer_end_ms(&p->timer);
     sl_target_resolve(&p->target);
     glFinish();
-    stats->wall_ms = sl_now_ms() - t0;
+    stats->wall_ms = sl_clock_ms() - t0;
     stats->gpu_bytes = p->technique->gpu_bytes ? p->technique->gpu_bytes(p->state) : 0;
     return st;
 }

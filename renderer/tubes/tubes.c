@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
@@ -118,7 +119,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK)
         goto fail;
-    double t_build = sl_now_ms();
+    double t_build = sl_clock_ms();
     st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1, &s->nodes, err);
     if (st != SL_OK)
         goto fail;
@@ -131,7 +132,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
         s->length_sum += chord;
         s->length_radius_sum += chord * 0.5 * fabs((double)a[3] + b[3]);
     }
-    s->prep.preprocess_ms = sl_now_ms() - t_build;
+    s->prep.preprocess_ms = sl_clock_ms() - t_build;
     const struct { const char *label, *vertex, *fragment; GLuint *program; int boxes; } programs[] = {
         {"tubes", "tubes/tubes.vert.glsl", "tubes/tubes.frag.glsl", &s->program, 1},
         {"tubes_silhouette", "tubes/tubes.vert.glsl", "tubes/tubes_silhouette.frag.glsl", &s->program_silhouette, 1},
@@ -149,7 +150,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
                                        programs[k].program, err)) != SL_OK)
             goto fail;
 
-    double t_upload = sl_now_ms();
+    double t_upload = sl_clock_ms();
     size_t nn = s->nodes.node_count ? s->nodes.node_count : 1;
     size_t ns = s->nodes.segment_count ? s->nodes.segment_count : 1;
     glCreateBuffers(1, &s->node_vbo);
@@ -180,7 +181,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glGenQueries(1, &s->query);
     glFinish();
-    s->prep.upload_ms = sl_now_ms() - t_upload;
+    s->prep.upload_ms = sl_clock_ms() - t_upload;
     s->gpu_bytes = nn * (SL_TUBES_NODE_FLOATS + 2) * sizeof(float) + ns * 2 * sizeof(uint32_t) +
                    SL_COLORMAP_TEXELS * 4;
     /* The geometry lives on the GPU now; keep only the colour scalars. */

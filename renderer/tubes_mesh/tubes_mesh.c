@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
@@ -76,7 +77,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     }
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
-    double t_build = sl_now_ms();
+    double t_build = sl_clock_ms();
     sl_lines lines = ds->lines; /* a view: only the radii may differ */
     float *attribute_radii = NULL;
     if (style.radius_attribute >= 0) {
@@ -97,7 +98,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
         free(s);
         return st;
     }
-    s->prep.preprocess_ms = sl_now_ms() - t_build;
+    s->prep.preprocess_ms = sl_clock_ms() - t_build;
     st = sl_gl_program_create(&(sl_program_desc){
         .vertex = "tubes_mesh/tubes_mesh.vert.glsl",
         .fragment = "tubes_mesh/tubes_mesh.frag.glsl",
@@ -107,7 +108,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
         tubes_mesh_release(s);
         return st;
     }
-    double t_upload = sl_now_ms();
+    double t_upload = sl_clock_ms();
     glCreateBuffers(1, &s->vbo);
     /* Empty meshes still get a (1-element) buffer so the VAO is complete. */
     glNamedBufferStorage(s->vbo, (GLsizeiptr)((mesh.vertex_count ? mesh.vertex_count : 1) * sizeof(sl_tube_vertex)),
@@ -144,7 +145,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
                    (ds->lines.vertex_count + 1) * sizeof(float) + SL_COLORMAP_TEXELS * 4;
     sl_tube_mesh_deinit(&mesh);
     glFinish();
-    s->prep.upload_ms = sl_now_ms() - t_upload;
+    s->prep.upload_ms = sl_clock_ms() - t_upload;
     *out = s;
     return SL_OK;
 }

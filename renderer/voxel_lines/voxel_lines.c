@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
@@ -256,12 +257,12 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     sl_voxel_grid g;
     sl_voxel_grid_desc desc = {.resolution = s->resolution, .quant = s->quant, .padding = s->padding,
                                .max_per_voxel = s->max_per_voxel, .attribute = attribute};
-    double t_build = sl_now_ms();
+    double t_build = sl_clock_ms();
     sl_status st = s->use_gpu ? sl_voxel_grid_build_gpu(&g, s->dataset, &desc, err)
                               : sl_voxel_grid_build(&g, s->dataset, &desc, err);
     if (st != SL_OK)
         return st;
-    double t_pack = sl_now_ms();
+    double t_pack = sl_clock_ms();
     s->prep = (sl_prepare_stats){0};
     if (s->use_gpu)
         s->prep.gpu_ms = t_pack - t_build; /* compute passes + readback */
@@ -307,7 +308,7 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
                           "voxel_lines: a %zu-byte buffer exceeds the GPU's shader storage block limit of %lld bytes; "
                           "lower `grid` or `quantization`", biggest, (long long)max_block);
     }
-    double t_upload = sl_now_ms();
+    double t_upload = sl_clock_ms();
     s->prep.preprocess_ms += t_upload - t_pack; /* packing the counts and lines */
     s->offsets_buf = make_buffer(g.offsets, g.voxel_count * sizeof(uint32_t));
     s->counts_buf = make_buffer(packed, count_words * sizeof(uint32_t));
@@ -347,11 +348,11 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     s->density_valid = 0;
     st = upload_occupancy(s, g.counts, err);
     glFinish();
-    double t_reps = sl_now_ms();
+    double t_reps = sl_clock_ms();
     s->prep.upload_ms = t_reps - t_upload;
     if (st == SL_OK)
         st = upload_representatives(s, &g, err); /* mostly the CPU LoD build */
-    s->prep.preprocess_ms += sl_now_ms() - t_reps;
+    s->prep.preprocess_ms += sl_clock_ms() - t_reps;
     s->ready = st == SL_OK;
     if (st == SL_OK && g.dropped_overflow)
         fprintf(stderr, "voxel_lines: %zu lines dropped in %zu voxels above the %d-line header limit "

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../gpu/sl_gpu.h"
+#include "../core/sl_clock.h"
 
 /* --- Clipping ------------------------------------------------------------- */
 
@@ -355,7 +355,7 @@ sl_status sl_voxel_grid_build(sl_voxel_grid *g, const sl_dataset *ds, const sl_v
                               sl_err *err)
 {
     memset(g, 0, sizeof *g);
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_voxel_grid_desc d = desc ? *desc : (sl_voxel_grid_desc){0};
     if (d.quant == 0)
         d.quant = 32;
@@ -463,7 +463,7 @@ sl_status sl_voxel_grid_build(sl_voxel_grid *g, const sl_dataset *ds, const sl_v
     free(fill);
     free(pts);
     free(attr);
-    g->build_ms = sl_now_ms() - t0;
+    g->build_ms = sl_clock_ms() - t0;
     return SL_OK;
 fail:
     free(b.items);

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/sl_clock.h"
 #include "../gpu/sl_gpu.h"
 
 #define PASSES 5
@@ -109,7 +110,7 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
         limit = 65535; /* the GL 4.3 minimum */
     if (max_groups == 0 || max_groups > (unsigned)limit)
         max_groups = (unsigned)limit;
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     sl_voxel_grid_desc d = desc ? *desc : (sl_voxel_grid_desc){0};
     if (d.quant == 0) d.quant = 32;
     if (d.padding < 0) d.padding = 1;
@@ -292,7 +293,7 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
     }
     /* The CPU layout keeps 8 zero bytes after the last line. */
     memset(g->lines + s_kept * (size_t)g->line_bytes, 0, word_count * 4 - s_kept * (size_t)g->line_bytes);
-    g->build_ms = sl_now_ms() - t0;
+    g->build_ms = sl_clock_ms() - t0;
     st = SL_OK;
     goto done;
 fail:

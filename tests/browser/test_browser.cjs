@@ -2,7 +2,8 @@
 // against a private sightline-server on a free loopback port.
 //
 // Loads the page and sees a still frame with something drawn; drags the
-// canvas and sees a new frame showing the new camera (pixels differ);
+// canvas and sees a new frame showing the new camera (pixels differ); orbits
+// up to the elevation limit the server sent (and the server accepts it);
 // changes a parameter through its generated control and sees the session
 // state and a newer frame; opens the share link in a second page, which
 // joins as a viewer and shows the same frame id with identical pixels.
@@ -106,6 +107,30 @@ async function main() {
     await page.waitForFunction(() => /latency \d+ ms/.test(document.getElementById('status').textContent), null,
       { timeout: 5000 }).catch(() => {});
     check(/latency \d+ ms/.test(await page.textContent('#status')), 'status line shows latency');
+
+    // 2a. The page's camera numbers are the server's (welcome): a long upward
+    // orbit stops at the server's elevation limit, which the server accepts.
+    const lim = await page.evaluate(() => window.sightline.cameraLimits);
+    check(lim.maxElevation === 89.9 && lim.defaults && lim.defaults.orbit.distance === 2.5 && lim.defaults.fov_y === 45,
+      `camera defaults and elevation limit from welcome ${JSON.stringify(lim)}`);
+    const errorsBefore = await page.textContent('#banner');
+    for (let k = 0; k < 3; k++) {   // 0.4 degree per pixel: 3 drags of 0.4 x the canvas height pass any limit
+      await page.mouse.move(cx, cy - 0.2 * box.height);
+      await page.mouse.down();
+      for (let i = 1; i <= 8; i++) await page.mouse.move(cx, cy + (0.05 * i - 0.2) * box.height);
+      await page.mouse.up();
+    }
+    await page.waitForFunction((m) => window.sightline.state.camera.orbit &&
+      window.sightline.state.camera.orbit.elevation === m && !window.sightline.lastFrame.interactive &&
+      window.sightline.lastFrame.cameraSeq >= window.sightline.cameraSeq, lim.maxElevation, { timeout: T });
+    check((await page.textContent('#banner')) === errorsBefore, 'the server accepted the clamped elevation');
+    await page.mouse.move(cx, cy + 0.25 * box.height);
+    await page.mouse.down();
+    for (let i = 1; i <= 10; i++) await page.mouse.move(cx, cy + (0.25 - 0.05 * i) * box.height);
+    await page.mouse.up();
+    await page.waitForFunction(() => window.sightline.state.camera.orbit &&
+      window.sightline.state.camera.orbit.elevation < 45 && !window.sightline.lastFrame.interactive &&
+      window.sightline.lastFrame.cameraSeq >= window.sightline.cameraSeq, null, { timeout: T });
 
     // 2b. Wheel zooms (orbit distance grows), shift-drag pans (the camera becomes eye/target).
     const dist0 = await page.evaluate(() => window.sightline.state.camera.orbit.distance);

@@ -27,11 +27,11 @@
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_clock.h"
 #include "sl_protocol.h"
 #include "sl_wsclient.h"
 
@@ -45,13 +45,6 @@ typedef struct harness {
     char db[300];
     char exe[1024];
 } harness;
-
-static __attribute__((unused)) double harness_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
 
 static __attribute__((unused)) int harness_run_wait(char *const argv[])
 {
@@ -145,8 +138,8 @@ static __attribute__((unused)) int harness_start(harness *h, const char *const *
         return -1;
     char buf[4096];
     size_t len = 0;
-    double deadline = harness_now_ms() + 60000;
-    while (harness_now_ms() < deadline && len + 1 < sizeof buf) {
+    double deadline = sl_clock_ms() + 60000;
+    while (sl_clock_ms() < deadline && len + 1 < sizeof buf) {
         struct pollfd pfd = {.fd = h->out_fd, .events = POLLIN};
         if (poll(&pfd, 1, 200) <= 0)
             continue;
@@ -215,7 +208,7 @@ static __attribute__((unused)) int harness_stop(harness *h)
     int result = -1;
     if (h->pid > 0) {
         kill(h->pid, SIGTERM);
-        double deadline = harness_now_ms() + 20000;
+        double deadline = sl_clock_ms() + 20000;
         int status = 0;
         for (;;) {
             pid_t r = waitpid(h->pid, &status, WNOHANG);
@@ -223,7 +216,7 @@ static __attribute__((unused)) int harness_stop(harness *h)
                 result = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
                 break;
             }
-            if (harness_now_ms() > deadline) {
+            if (sl_clock_ms() > deadline) {
                 kill(h->pid, SIGKILL);
                 waitpid(h->pid, &status, 0);
                 break;
@@ -344,7 +337,7 @@ static __attribute__((unused)) int tclient_next(tclient *c, int timeout_ms, cJSO
     }
     free(c->last.payload);
     c->last.h = h;
-    c->last.arrival_ms = harness_now_ms();
+    c->last.arrival_ms = sl_clock_ms();
     c->last.payload = malloc(h.payload_bytes ? h.payload_bytes : 1);
     if (c->last.payload)
         memcpy(c->last.payload, data + SL_FRAME_HEADER_SIZE, h.payload_bytes);
@@ -362,10 +355,10 @@ static __attribute__((unused)) const char *json_type(const cJSON *j)
 /* Waits for a text message of the given type (frames and other texts are consumed). */
 static __attribute__((unused)) cJSON *tclient_wait_type(tclient *c, const char *type, int timeout_ms)
 {
-    double deadline = harness_now_ms() + timeout_ms;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + timeout_ms;
+    while (sl_clock_ms() < deadline) {
         cJSON *j = NULL;
-        int r = tclient_next(c, (int)(deadline - harness_now_ms()) + 1, &j);
+        int r = tclient_next(c, (int)(deadline - sl_clock_ms()) + 1, &j);
         if (r == 1 && strcmp(json_type(j), type) == 0)
             return j;
         cJSON_Delete(j);
@@ -378,9 +371,9 @@ static __attribute__((unused)) cJSON *tclient_wait_type(tclient *c, const char *
 /* Waits for a JPEG frame whose camera_seq >= seq and (still_only) not interactive. Returns 0 on success. */
 static __attribute__((unused)) int tclient_wait_frame(tclient *c, uint32_t seq, int still_only, int timeout_ms)
 {
-    double deadline = harness_now_ms() + timeout_ms;
-    while (harness_now_ms() < deadline) {
-        int r = tclient_next(c, (int)(deadline - harness_now_ms()) + 1, NULL);
+    double deadline = sl_clock_ms() + timeout_ms;
+    while (sl_clock_ms() < deadline) {
+        int r = tclient_next(c, (int)(deadline - sl_clock_ms()) + 1, NULL);
         if (r == 2 && c->last.h.kind == SL_FRAME_JPEG && c->last.h.camera_seq >= seq &&
             (!still_only || !(c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE)))
             return 0;
@@ -415,8 +408,8 @@ static __attribute__((unused)) int harness_http_get(int port, const char *host, 
         return -1;
     }
     size_t len = 0;
-    double deadline = harness_now_ms() + 5000;
-    while (len + 1 < out_size && harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + 5000;
+    while (len + 1 < out_size && sl_clock_ms() < deadline) {
         struct pollfd pfd = {.fd = fd, .events = POLLIN};
         if (poll(&pfd, 1, 200) <= 0)
             continue;
@@ -442,8 +435,8 @@ static __attribute__((unused)) int tclient_hello(tclient *c, const char *session
     if (rc)
         return -1;
     cJSON *wel = NULL;
-    double deadline = harness_now_ms() + 20000;
-    while (!wel && harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + 20000;
+    while (!wel && sl_clock_ms() < deadline) {
         cJSON *j = NULL;
         int r = tclient_next(c, 20000, &j);
         if (r == 1 && (strcmp(json_type(j), "welcome") == 0 || strcmp(json_type(j), "error") == 0))

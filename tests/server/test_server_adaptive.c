@@ -40,15 +40,15 @@ typedef struct drag_result {
 static drag_result drag_for(tclient *c, uint32_t *seq, int sw, int sh, int drag_ms)
 {
     drag_result r = {.min_w = 1 << 30, .heights_ok = 1};
-    double t0 = harness_now_ms(), next = t0;
+    double t0 = sl_clock_ms(), next = t0;
     double az = 10;
-    while (harness_now_ms() - t0 < drag_ms) {
-        if (harness_now_ms() >= next) {
+    while (sl_clock_ms() - t0 < drag_ms) {
+        if (sl_clock_ms() >= next) {
             tclient_send(c, "{\"type\":\"camera\",\"seq\":%u,\"phase\":\"move\",\"camera\":{\"orbit\":"
                             "{\"azimuth\":%.2f,\"elevation\":20,\"distance\":2.5}}}", ++*seq, az += 3);
             next += 1000.0 / 30.0;
         }
-        int wait = (int)(next - harness_now_ms());
+        int wait = (int)(next - sl_clock_ms());
         if (tclient_next(c, wait < 1 ? 1 : wait, NULL) == 2 && c->last.h.kind == SL_FRAME_JPEG &&
             (c->last.h.flags & SL_FRAME_FLAG_INTERACTIVE)) {
             int w = c->last.h.width, h = c->last.h.height;

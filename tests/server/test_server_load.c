@@ -201,10 +201,10 @@ static long rss_kib(pid_t pid)
 
 static double healthz_ms(int port)
 {
-    double t0 = harness_now_ms();
+    double t0 = sl_clock_ms();
     char buf[1024];
     int status = harness_http_get(port, NULL, "/healthz", buf, sizeof buf);
-    return status == 200 && strstr(buf, "\"status\":\"ok\"") ? harness_now_ms() - t0 : 1e9;
+    return status == 200 && strstr(buf, "\"status\":\"ok\"") ? sl_clock_ms() - t0 : 1e9;
 }
 
 int main(void)
@@ -228,7 +228,7 @@ int main(void)
         w[i] = (worker){.port = h.port, .index = i, .barrier = &barrier};
         pthread_create(&th[i], NULL, run_worker, &w[i]);
     }
-    double t0 = harness_now_ms();
+    double t0 = sl_clock_ms();
     pthread_barrier_wait(&barrier);          /* all connected: round 1 starts */
     double worst = 0;
     pthread_barrier_wait(&barrier);          /* round 1 sent and drained */
@@ -242,7 +242,7 @@ int main(void)
     }
     for (int i = 0; i < CLIENTS; i++)
         pthread_join(th[i], NULL);
-    double total_ms = harness_now_ms() - t0;
+    double total_ms = sl_clock_ms() - t0;
     long rss2 = rss_kib(h.pid);
 
     int connected = 0, final_ok = 0, frames = 0;

@@ -97,8 +97,8 @@ static int http_get(int port, const char *path, char *out, size_t out_size)
 /* Waits for a state patch whose `key` is the string `value`; returns its version (0 on timeout). */
 static uint32_t wait_patch(tclient *c, const char *key, const char *value)
 {
-    double deadline = harness_now_ms() + T;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + T;
+    while (sl_clock_ms() < deadline) {
         cJSON *m = tclient_wait_type(c, "state", T);
         if (!m)
             return 0;
@@ -115,8 +115,8 @@ static uint32_t wait_patch(tclient *c, const char *key, const char *value)
 /* Waits for a still frame that shows state version >= version. */
 static int wait_version(tclient *c, uint32_t version)
 {
-    double deadline = harness_now_ms() + T;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + T;
+    while (sl_clock_ms() < deadline) {
         if (tclient_wait_frame(c, 0, 1, T) != 0)
             return -1;
         if (c->last.h.state_version >= version)
@@ -128,8 +128,8 @@ static int wait_version(tclient *c, uint32_t version)
 /* Waits for a state patch carrying `key`; returns the message (caller frees) or NULL. */
 static cJSON *wait_patch_key(tclient *c, const char *key)
 {
-    double deadline = harness_now_ms() + T;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + T;
+    while (sl_clock_ms() < deadline) {
         cJSON *m = tclient_wait_type(c, "state", T);
         if (!m)
             return NULL;
@@ -166,8 +166,8 @@ static int refused_for_viewer(tclient *c, const char *msg)
 /* Waits for a text of the given type or an error; returns it (caller frees) or NULL. */
 static cJSON *wait_reply(tclient *c, const char *type)
 {
-    double deadline = harness_now_ms() + T;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + T;
+    while (sl_clock_ms() < deadline) {
         cJSON *j = NULL;
         int r = tclient_next(c, T, &j);
         if (r == 1 && (strcmp(json_type(j), type) == 0 || strcmp(json_type(j), "error") == 0))
@@ -201,8 +201,8 @@ static int http_status_with_host(int port, const char *host)
  * received meanwhile into *errors. 1 when the frame came. */
 static int wait_still_counting_errors(tclient *c, uint32_t seq, int *errors)
 {
-    double deadline = harness_now_ms() + T;
-    while (harness_now_ms() < deadline) {
+    double deadline = sl_clock_ms() + T;
+    while (sl_clock_ms() < deadline) {
         cJSON *j = NULL;
         int rr = tclient_next(c, T, &j);
         if (rr == 1 && strcmp(json_type(j), "error") == 0)
@@ -274,6 +274,14 @@ int main(void)
     SL_CHECK(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(a.welcome, "datasets")) >= 2);
     SL_CHECK(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "limits"), "ack_window")
                  ->valueint == 2);
+    /* The page's camera numbers: a new session starts at camera_default, and the limit is core's. */
+    {
+        const cJSON *me = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "limits"),
+                                                           "max_elevation");
+        SL_CHECK(cJSON_IsNumber(me) && me->valuedouble == SL_ORBIT_MAX_ELEVATION);
+        const cJSON *cd = cJSON_GetObjectItemCaseSensitive(a.welcome, "camera_default");
+        SL_CHECK(cJSON_IsObject(cd) && cJSON_Compare(cd, cJSON_GetObjectItemCaseSensitive(wst, "camera"), 1));
+    }
     a.auto_ack = 1;
 
     /* --- first frame arrives, header valid, decodes to the session size, shows something --- */
@@ -309,7 +317,7 @@ int main(void)
     cJSON *se = tclient_wait_type(&a, "error", T);
     SL_CHECK(error_is(se, "bad_field", "stream.still_delay_ms"));
     cJSON_Delete(se);
-    double move_sent = harness_now_ms();
+    double move_sent = sl_clock_ms();
     SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":6,\"phase\":\"move\",\"camera\":{\"orbit\":{\"azimuth\":140,\"elevation\":-20,\"distance\":2}}}") == 0);
     SL_CHECK(tclient_wait_frame(&a, 6, 0, T) == 0);
     int saw_interactive = (a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE) != 0;
@@ -387,6 +395,13 @@ int main(void)
         const cJSON *seq = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "camera_seq");
         SL_CHECK_MSG(v0 > 0 && v1 == v0 + 1, "state version %u -> %u across refused cameras", v0, v1);
         SL_CHECK(seq && seq->valueint == 70);
+        /* The state echoes the parsed camera, complete: the fov the client left out is the default. */
+        const cJSON *pc = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "camera");
+        const cJSON *fov = cJSON_GetObjectItemCaseSensitive(pc, "fov_y");
+        SL_CHECK_MSG(cJSON_IsNumber(fov) && fov->valuedouble == sl_orbit_default.fov_y_deg &&
+                         cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(pc, "orbit"), "azimuth")
+                                 ->valuedouble == 15.0,
+                     "camera echo is not complete");
         cJSON_Delete(m);
         int render_failed = 0;
         int got = wait_still_counting_errors(&a, 70, &render_failed);
@@ -483,12 +498,12 @@ int main(void)
     {
         tclient silent;
         SL_CHECK(tclient_connect(&silent, h.port, NULL) == 0);
-        double t0 = harness_now_ms();
+        double t0 = sl_clock_ms();
         int rr;
         do {
             rr = tclient_next(&silent, 6000, NULL);
         } while (rr > 0);
-        double waited = harness_now_ms() - t0;
+        double waited = sl_clock_ms() - t0;
         SL_CHECK_MSG(silent.closed && waited >= 1900 && waited < 4500, "silent client closed=%d after %.0f ms",
                      silent.closed, waited);
         tclient_close(&silent);
@@ -538,8 +553,8 @@ int main(void)
             flood[i] = "{\"type\":\"control\",\"action\":\"request\"}";
         SL_CHECK(sl_wsclient_send_texts(b.ws, flood, 100, &b.err) == SL_OK);
         int notes = 0, wrong = 0;
-        double until = harness_now_ms() + 1500;
-        while (harness_now_ms() < until && !a.closed) {
+        double until = sl_clock_ms() + 1500;
+        while (sl_clock_ms() < until && !a.closed) {
             cJSON *j = NULL;
             if (tclient_next(&a, 100, &j) == 1 && strcmp(json_type(j), "control_request") == 0) {
                 notes++;
@@ -590,8 +605,8 @@ int main(void)
         SL_CHECK(tclient_wait_frame(&a, (uint32_t)(20 + i), 1, T) == 0);
     }
     /* Drain the lazy client for a while without acking. */
-    double until = harness_now_ms() + 1500;
-    while (harness_now_ms() < until)
+    double until = sl_clock_ms() + 1500;
+    while (sl_clock_ms() < until)
         if (tclient_next(&lazy, 100, NULL) == 0)
             break;
     /* The frame at join plus one more fill the window of 2; six more renders send nothing. */
@@ -611,8 +626,8 @@ int main(void)
     sl_image still_jpeg = decode_last(&a);
     SL_CHECK(tclient_send(&a, "{\"type\":\"snapshot\"}") == 0);
     int got_png = 0;
-    double sdl = harness_now_ms() + T;
-    while (!got_png && harness_now_ms() < sdl) {
+    double sdl = sl_clock_ms() + T;
+    while (!got_png && sl_clock_ms() < sdl) {
         if (tclient_next(&a, T, NULL) == 2 && a.last.h.kind == SL_FRAME_PNG)
             got_png = 1;
     }
@@ -749,8 +764,8 @@ int main(void)
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
         int saw_dataset = 0, saw_bounds = 0;
         uint32_t version = 0;
-        double deadline = harness_now_ms() + T;
-        while ((!saw_dataset || !saw_bounds) && harness_now_ms() < deadline) {
+        double deadline = sl_clock_ms() + T;
+        while ((!saw_dataset || !saw_bounds) && sl_clock_ms() < deadline) {
             cJSON *m = tclient_wait_type(&a, "state", T);
             if (!m)
                 break;

@@ -11,7 +11,8 @@
  * hit 2e-5 in NDC (and absolute-coordinate float matrices must not: a
  * control that shows the check can fail). Also: reversed infinite-far depth
  * and sl_view_depth_to_distance against the Euclidean distance, sl_view_ray_dir,
- * the orbit conventions, and rejection of degenerate cameras without NaN.
+ * the orbit conventions, rejection of degenerate cameras without NaN, and
+ * the one set of defaults (sl_orbit_default) and sl_camera_spec_resolve.
  */
 #include <math.h>
 #include <stdint.h>
@@ -612,6 +613,34 @@ static void test_validation(void)
     SL_CHECK(mat_finite(&v.view_projection) && vec_finite(v.origin));
 }
 
+/* The defaults every caller takes (scene, session, the page through the
+ * welcome) and the resolution of either form of sl_camera_spec. */
+static void test_spec(void)
+{
+    SL_CHECK(sl_orbit_default.azimuth_deg == 30.0 && sl_orbit_default.elevation_deg == 20.0 &&
+             sl_orbit_default.distance == 2.5 && sl_orbit_default.fov_y_deg == 45.0);
+    SL_CHECK(SL_ORBIT_MAX_ELEVATION == 89.9);
+    sl_camera_spec d = sl_camera_spec_default();
+    SL_CHECK(d.is_orbit == 1 && memcmp(&d.orbit, &sl_orbit_default, sizeof d.orbit) == 0);
+    sl_vec3 lo = sl_v3(-1, 0, 2), hi = sl_v3(3, 2, 6);
+    sl_camera a, b;
+    sl_err err = {0};
+    SL_CHECK(sl_camera_spec_resolve(&d, lo, hi, &a, &err) == SL_OK);
+    SL_CHECK(sl_camera_from_orbit(&sl_orbit_default, lo, hi, &b, &err) == SL_OK);
+    SL_CHECK(memcmp(&a, &b, sizeof a) == 0);
+    sl_camera_spec look = {.is_orbit = 0,
+                           .look_at = {.eye = sl_v3(0, 0, 5), .target = sl_v3(0, 0, 0), .up = sl_v3(0, 1, 0),
+                                       .fov_y_deg = 40.0}};
+    SL_CHECK(sl_camera_spec_resolve(&look, lo, hi, &a, &err) == SL_OK);
+    SL_CHECK(memcmp(&a, &look.look_at, sizeof a) == 0);   /* bounds do not move an eye/target camera */
+    look.look_at.up = sl_v3(0, 0, 1);
+    SL_CHECK(sl_camera_spec_resolve(&look, lo, hi, &a, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "camera.up") != NULL, "%s", err.message);
+    d.orbit.elevation_deg = 90.0;
+    SL_CHECK(sl_camera_spec_resolve(&d, lo, hi, &a, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "camera.orbit.elevation") != NULL, "%s", err.message);
+}
+
 int main(void)
 {
     test_math();
@@ -619,6 +648,7 @@ int main(void)
     test_big_offset();
     test_orbit();
     test_validation();
+    test_spec();
     printf("worst NDC error of a pixel-centre ray: %.3g (double), %.3g (float, origin-relative);"
            " absolute float matrices: >= %.3g\n", worst_ndc_seen, worst_float_seen, best_control_seen);
     SL_TEST_END();

@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "core/sl_clock.h"
 #include "data/gen_family.h"
 #include "data/gen_random.h"
 #include "data/gen_trace.h"
@@ -45,13 +45,6 @@ static sl_dataset *gen(const char *json)
     sl_status st = sl_generate_json(json, &ds, &err);
     SL_CHECK_MSG(st == SL_OK && ds, "%s -> %s", json, err.message);
     return st == SL_OK ? ds : NULL;
-}
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
 static int arrays_equal(const void *a, const void *b, size_t bytes)
@@ -266,9 +259,9 @@ static void test_furball(void)
         SL_CHECK(sl_lines_find_attribute(&ds->lines, "arclength") >= 0);
         sl_dataset_destroy(ds);
     }
-    double t0 = now_ms();
+    double t0 = sl_clock_ms();
     sl_dataset *ds = gen("{\"generator\":\"furball\",\"segments\":787000}");
-    double ms = now_ms() - t0;
+    double ms = sl_clock_ms() - t0;
     printf("furball 787000 segments: %.0f ms%s\n", ms, SANITIZED ? " (sanitized build)" : "");
     if (ds) {
         size_t s = segment_count(&ds->lines);
@@ -661,9 +654,9 @@ static void test_catalog(void)
     SL_CHECK(n >= 8);
     for (int i = 0; i < n; i++) {
         SL_CHECK(sl_builtin_lookup(b[i].name) == b[i].generator_json);
-        double t0 = now_ms();
+        double t0 = sl_clock_ms();
         sl_dataset *ds = gen(b[i].generator_json);
-        double ms = now_ms() - t0;
+        double ms = sl_clock_ms() - t0;
         printf("built-in %-16s %8.1f ms\n", b[i].name, ms);
         if (ds)
             SL_CHECK_MSG(all_finite(ds), "built-in %s", b[i].name);

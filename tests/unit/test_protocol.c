@@ -3,7 +3,8 @@
  * Every message type parses with its fields; every kind of bad input gives
  * SL_ERR_INVALID with the documented code and offending field and leaves the
  * message zeroed; stream settings patch all or nothing, naming the bad key;
- * the frame header round-trips every field bit-exactly and
+ * welcome carries core's default camera and elevation limit, and state the
+ * complete camera; the frame header round-trips every field bit-exactly and
  * rejects short buffers, a wrong magic, an unknown kind and a payload size
  * that disagrees with the message. No server, no GL.
  */
@@ -129,6 +130,43 @@ int main(void)
     SL_CHECK(cJSON_IsFalse(cJSON_GetObjectItem(sj, "interactive_adaptive")));
     SL_CHECK(cJSON_GetObjectItem(sj, "interactive_budget_ms")->valueint == 250);
     cJSON_Delete(sj);
+
+    /* welcome: the page's camera defaults and elevation limit come from core/sl_camera.h */
+    char *wt = sl_msg_welcome_text(&(sl_msg_welcome){.session = "s", .token = "t", .client = 1});
+    cJSON *wj = cJSON_Parse(wt);
+    const cJSON *cd = cJSON_GetObjectItemCaseSensitive(wj, "camera_default");
+    const cJSON *co = cJSON_GetObjectItemCaseSensitive(cd, "orbit");
+    SL_CHECK(cJSON_IsObject(co) && cJSON_GetObjectItem(co, "azimuth")->valuedouble == sl_orbit_default.azimuth_deg &&
+             cJSON_GetObjectItem(co, "elevation")->valuedouble == sl_orbit_default.elevation_deg &&
+             cJSON_GetObjectItem(co, "distance")->valuedouble == sl_orbit_default.distance);
+    SL_CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cd, "fov_y")) &&
+             cJSON_GetObjectItem(cd, "fov_y")->valuedouble == sl_orbit_default.fov_y_deg);
+    const cJSON *me = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(wj, "limits"), "max_elevation");
+    SL_CHECK(cJSON_IsNumber(me) && me->valuedouble == SL_ORBIT_MAX_ELEVATION);
+    cJSON_Delete(wj);
+    free(wt);
+
+    /* camera check: the typed camera comes out, with defaults for what the client left out */
+    cJSON *cj = cJSON_Parse("{\"orbit\":{\"azimuth\":75}}");
+    sl_camera_spec spec = {0};
+    SL_CHECK(sl_msg_camera_check(cj, NULL, &spec, &err) == SL_OK);
+    SL_CHECK(spec.is_orbit && spec.orbit.azimuth_deg == 75.0 && spec.orbit.elevation_deg == 20.0 &&
+             spec.orbit.distance == 2.5 && spec.orbit.fov_y_deg == 45.0);
+    cJSON_Delete(cj);
+    cj = cJSON_Parse("{\"orbit\":{\"distance\":2e6}}");
+    sl_camera_spec kept = spec;
+    SL_CHECK(sl_msg_camera_check(cj, NULL, &spec, &err) == SL_ERR_INVALID && memcmp(&kept, &spec, sizeof spec) == 0);
+    cJSON_Delete(cj);
+    sl_params no_params = {0};
+    const float bg[4] = {0, 0, 0, 1};
+    sl_stream_settings defaults = SL_STREAM_DEFAULTS;
+    cJSON *stj = sl_msg_state_json(&(sl_msg_state){.dataset = "d", .technique = "t", .params = &no_params,
+                                                    .camera = &spec, .background = bg, .stream = &defaults});
+    const cJSON *sc = cJSON_GetObjectItemCaseSensitive(stj, "camera");
+    SL_CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(sc, "orbit"), "azimuth")->valuedouble == 75.0 &&
+             cJSON_GetObjectItem(cJSON_GetObjectItem(sc, "orbit"), "distance")->valuedouble == 2.5 &&
+             cJSON_GetObjectItem(sc, "fov_y")->valuedouble == 45.0);
+    cJSON_Delete(stj);
 
     /* frame header */
     sl_frame_header h = {.kind = SL_FRAME_JPEG, .flags = SL_FRAME_FLAG_INTERACTIVE, .frame_id = 0xdeadbeef,

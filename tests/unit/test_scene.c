@@ -14,6 +14,7 @@
  * a frame. No GL.
  */
 #include <cjson/cJSON.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -84,9 +85,9 @@ static void test_defaults(void)
     SL_CHECK(cJSON_IsString(s.dataset) && strcmp(s.dataset->valuestring, "tornado") == 0);
     SL_CHECK(strcmp(s.technique, "tubes_mesh") == 0);
     SL_CHECK(s.params == NULL);
-    SL_CHECK(s.camera_is_orbit == 1);
-    SL_CHECK(s.orbit.azimuth_deg == 30.0 && s.orbit.elevation_deg == 20.0 && s.orbit.distance == 2.5);
-    SL_CHECK(s.orbit.fov_y_deg == 45.0);
+    SL_CHECK(s.camera.is_orbit == 1);
+    SL_CHECK(s.camera.orbit.azimuth_deg == 30.0 && s.camera.orbit.elevation_deg == 20.0 && s.camera.orbit.distance == 2.5);
+    SL_CHECK(s.camera.orbit.fov_y_deg == 45.0);
     SL_CHECK(s.width == 256 && s.height == 256);
     SL_CHECK(float_eq(s.background[0], 0.1f) && float_eq(s.background[1], 0.1f) && float_eq(s.background[2], 0.12f) &&
              float_eq(s.background[3], 1.0f));
@@ -105,7 +106,7 @@ static void test_valid(void)
                  " \"camera\": {\"orbit\": {\"azimuth\": 30, \"elevation\": 20, \"distance\": 2.2}, \"fov_y\": 45},"
                  " \"width\": 640, \"height\": 480, \"background\": [0.1, 0.1, 0.12, 1]}", &s)) {
         SL_CHECK(s.width == 640 && s.height == 480);
-        SL_CHECK(s.camera_is_orbit && s.orbit.distance == 2.2 && s.orbit.fov_y_deg == 45.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.distance == 2.2 && s.camera.orbit.fov_y_deg == 45.0);
         const cJSON *r = cJSON_GetObjectItemCaseSensitive(s.params, "radius");
         SL_CHECK(cJSON_IsNumber(r) && r->valuedouble == 0.01);
         sl_scene_deinit(&s);
@@ -133,26 +134,26 @@ static void test_valid(void)
     /* Camera, explicit, with and without up. */
     if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"eye\": [1, 2, 3], \"target\": [0, -1, 0.5],"
                  " \"up\": [0, 0, 1], \"fov_y\": 30}}", &s)) {
-        SL_CHECK(!s.camera_is_orbit);
-        SL_CHECK(s.camera.eye.x == 1 && s.camera.eye.y == 2 && s.camera.eye.z == 3);
-        SL_CHECK(s.camera.target.x == 0 && s.camera.target.y == -1 && s.camera.target.z == 0.5);
-        SL_CHECK(s.camera.up.x == 0 && s.camera.up.y == 0 && s.camera.up.z == 1);
-        SL_CHECK(s.camera.fov_y_deg == 30.0);
+        SL_CHECK(!s.camera.is_orbit);
+        SL_CHECK(s.camera.look_at.eye.x == 1 && s.camera.look_at.eye.y == 2 && s.camera.look_at.eye.z == 3);
+        SL_CHECK(s.camera.look_at.target.x == 0 && s.camera.look_at.target.y == -1 && s.camera.look_at.target.z == 0.5);
+        SL_CHECK(s.camera.look_at.up.x == 0 && s.camera.look_at.up.y == 0 && s.camera.look_at.up.z == 1);
+        SL_CHECK(s.camera.look_at.fov_y_deg == 30.0);
         sl_scene_deinit(&s);
     }
     if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"eye\": [0, 0, 5], \"target\": [0, 0, 0]}}", &s)) {
-        SL_CHECK(!s.camera_is_orbit && s.camera.up.x == 0 && s.camera.up.y == 1 && s.camera.up.z == 0);
-        SL_CHECK(s.camera.fov_y_deg == 45.0);
+        SL_CHECK(!s.camera.is_orbit && s.camera.look_at.up.x == 0 && s.camera.look_at.up.y == 1 && s.camera.look_at.up.z == 0);
+        SL_CHECK(s.camera.look_at.fov_y_deg == 45.0);
         sl_scene_deinit(&s);
     }
     /* Orbit: missing fields take the defaults; fov_y sits beside orbit. */
     if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"orbit\": {\"azimuth\": -75.5}, \"fov_y\": 60}}", &s)) {
-        SL_CHECK(s.camera_is_orbit && s.orbit.azimuth_deg == -75.5 && s.orbit.elevation_deg == 20.0 &&
-                 s.orbit.distance == 2.5 && s.orbit.fov_y_deg == 60.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.azimuth_deg == -75.5 && s.camera.orbit.elevation_deg == 20.0 &&
+                 s.camera.orbit.distance == 2.5 && s.camera.orbit.fov_y_deg == 60.0);
         sl_scene_deinit(&s);
     }
     if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"orbit\": {}}}", &s)) {
-        SL_CHECK(s.camera_is_orbit && s.orbit.azimuth_deg == 30.0 && s.orbit.fov_y_deg == 45.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.azimuth_deg == 30.0 && s.camera.orbit.fov_y_deg == 45.0);
         sl_scene_deinit(&s);
     }
 
@@ -257,16 +258,16 @@ static void test_invalid(void)
     sl_scene ok;
     if (parse_ok("{\"dataset\": \"x.vtk\", \"orbit_frames\": 0, \"camera\": {\"eye\": [0, 0, 5], \"target\": [0, 0, 0]}}",
                  &ok)) {
-        SL_CHECK(!ok.camera_is_orbit && ok.orbit_frames == 0);
+        SL_CHECK(!ok.camera.is_orbit && ok.orbit_frames == 0);
         sl_scene_deinit(&ok);
     }
     if (parse_ok("{\"dataset\": \"x.vtk\", \"orbit_frames\": 8}", &ok)) {   /* the default camera is an orbit */
-        SL_CHECK(ok.camera_is_orbit && ok.orbit_frames == 8);
+        SL_CHECK(ok.camera.is_orbit && ok.orbit_frames == 8);
         sl_scene_deinit(&ok);
     }
     /* Elevation at its limits is accepted as given (no clamp). */
     if (parse_ok("{\"dataset\": \"x.vtk\", \"camera\": {\"orbit\": {\"elevation\": -89.9}}}", &ok)) {
-        SL_CHECK(ok.orbit.elevation_deg == -89.9);
+        SL_CHECK(ok.camera.orbit.elevation_deg == -89.9);
         sl_scene_deinit(&ok);
     }
 
@@ -367,13 +368,74 @@ static void test_nan_in_memory(void)
     cJSON *cam = cJSON_CreateObject();
     cJSON *orbit = cJSON_AddObjectToObject(cam, "orbit");
     cJSON_AddNumberToObject(orbit, "distance", NAN);
-    int is_orbit = -1;
-    sl_camera c = {0};
-    sl_orbit o = {0};
+    sl_camera_spec spec = {.is_orbit = -1};
     sl_err err = {0};
-    SL_CHECK(sl_camera_json_parse(cam, &is_orbit, &c, &o, &err) == SL_ERR_INVALID);
-    SL_CHECK(is_orbit == -1 && o.distance == 0.0);   /* outputs untouched on failure */
+    SL_CHECK(sl_camera_json_parse(cam, &spec, &err) == SL_ERR_INVALID);
+    SL_CHECK(spec.is_orbit == -1 && spec.orbit.distance == 0.0);   /* output untouched on failure */
     cJSON_Delete(cam);
+}
+
+/* n doubles at a and b agree to within cJSON's printing, which writes 15
+ * digits when they read back within DBL_EPSILON (relative) of the value. */
+static int same_printed(const void *a, const void *b, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double x, y;
+        memcpy(&x, (const double *)a + i, sizeof x);
+        memcpy(&y, (const double *)b + i, sizeof y);
+        if (!(fabs(x - y) <= 2.0 * DBL_EPSILON * fmax(fabs(x), fabs(y))))
+            return 0;
+    }
+    return 1;
+}
+
+/* sl_camera_to_json writes every key (defaults included) and reads back to
+ * the same numbers (to cJSON's printing precision) in both forms. */
+static void test_camera_json(void)
+{
+    const char *cases[] = {
+        "{}",   /* no camera key: the scene's default */
+        "{\"camera\": {\"orbit\": {\"azimuth\": 75}}}",
+        "{\"camera\": {\"orbit\": {\"azimuth\": 0.1, \"elevation\": -89.9, \"distance\": 1e-3}, \"fov_y\": 179.5}}",
+        "{\"camera\": {\"eye\": [1, 2, 3], \"target\": [0.30000000000000004, -1, 1e30]}}",
+        "{\"camera\": {\"eye\": [0, 0, -5], \"target\": [0, 0, 0], \"up\": [1, 0, 0], \"fov_y\": 33.3}}",
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[512];
+        snprintf(text, sizeof text, "{\"dataset\": \"x.vtk\"%s%s", strcmp(cases[i], "{}") ? ", " : "",
+                 strcmp(cases[i], "{}") ? cases[i] + 1 : "}");
+        sl_scene s;
+        sl_err err = {0};
+        if (sl_scene_parse(text, &s, &err) != SL_OK) {
+            SL_CHECK_MSG(0, "%s: %s", text, err.message);
+            continue;
+        }
+        cJSON *j = sl_camera_to_json(&s.camera);
+        SL_CHECK(j && cJSON_IsNumber(cJSON_GetObjectItemCaseSensitive(j, "fov_y")));
+        const char *const *keys = s.camera.is_orbit ? (const char *const[]){"orbit", NULL}
+                                                    : (const char *const[]){"eye", "target", "up", NULL};
+        for (int k = 0; keys[k]; k++)
+            SL_CHECK_MSG(cJSON_HasObjectItem(j, keys[k]), "%s: no %s written", text, keys[k]);
+        char *printed = cJSON_PrintUnformatted(j);
+        cJSON *back = cJSON_Parse(printed);
+        sl_camera_spec again = {0};
+        SL_CHECK_MSG(sl_camera_json_parse(back, &again, &err) == SL_OK, "%s -> %s: %s", text, printed, err.message);
+        int same = again.is_orbit == s.camera.is_orbit &&
+                   (s.camera.is_orbit
+                        ? same_printed(&again.orbit, &s.camera.orbit, sizeof again.orbit / sizeof(double))
+                        : same_printed(&again.look_at, &s.camera.look_at, sizeof again.look_at / sizeof(double)));
+        SL_CHECK_MSG(same, "%s -> %s does not read back to the same camera", text, printed);
+        free(printed);
+        cJSON_Delete(back);
+        cJSON_Delete(j);
+        sl_scene_deinit(&s);
+    }
+    /* The scene's default is core's. */
+    sl_scene s;
+    sl_err err = {0};
+    SL_CHECK(sl_scene_parse("{\"dataset\": \"x.vtk\"}", &s, &err) == SL_OK);
+    SL_CHECK(s.camera.is_orbit && memcmp(&s.camera.orbit, &sl_orbit_default, sizeof s.camera.orbit) == 0);
+    sl_scene_deinit(&s);
 }
 
 /* ---- --set overrides ------------------------------------------------------ */
@@ -390,9 +452,9 @@ static void test_overrides(void)
     sl_status st = parse_with(explicit_cam, sets1, 2, &s, &err);
     SL_CHECK_MSG(st == SL_OK, "%s", err.message);
     if (st == SL_OK) {
-        SL_CHECK(s.camera_is_orbit && s.orbit.azimuth_deg == 30.0 && s.orbit.elevation_deg == 20.0 &&
-                 s.orbit.distance == 2.5);
-        SL_CHECK(s.orbit.fov_y_deg == 50.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.azimuth_deg == 30.0 && s.camera.orbit.elevation_deg == 20.0 &&
+                 s.camera.orbit.distance == 2.5);
+        SL_CHECK(s.camera.orbit.fov_y_deg == 50.0);
         const cJSON *r = cJSON_GetObjectItemCaseSensitive(s.params, "radius");
         const cJSON *sd = cJSON_GetObjectItemCaseSensitive(s.params, "sides");
         SL_CHECK(cJSON_IsNumber(r) && r->valuedouble == 0.5);
@@ -407,13 +469,13 @@ static void test_overrides(void)
     st = parse_with(with_up, sets_up, 1, &s, &err);
     SL_CHECK_MSG(st == SL_OK, "orbit over eye/target/up: %s", err.message);
     if (st == SL_OK) {
-        SL_CHECK(s.camera_is_orbit && s.orbit.distance == 2.0 && s.orbit.azimuth_deg == 30.0 &&
-                 s.orbit.elevation_deg == 20.0 && s.orbit.fov_y_deg == 40.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.distance == 2.0 && s.camera.orbit.azimuth_deg == 30.0 &&
+                 s.camera.orbit.elevation_deg == 20.0 && s.camera.orbit.fov_y_deg == 40.0);
         sl_scene_deinit(&s);
     }
     const char *sets_up2[] = {"camera.orbit={\"azimuth\": 5}"};
     st = parse_with(with_up, sets_up2, 1, &s, &err);
-    SL_CHECK_MSG(st == SL_OK && s.camera_is_orbit && s.orbit.azimuth_deg == 5.0, "camera.orbit={...}: %s",
+    SL_CHECK_MSG(st == SL_OK && s.camera.is_orbit && s.camera.orbit.azimuth_deg == 5.0, "camera.orbit={...}: %s",
                  st ? err.message : "wrong orbit");
     if (st == SL_OK)
         sl_scene_deinit(&s);
@@ -429,7 +491,7 @@ static void test_overrides(void)
     st = parse_with("{\"dataset\": \"tornado\"}", sets2, 3, &s, &err);
     SL_CHECK_MSG(st == SL_OK, "%s", err.message);
     if (st == SL_OK) {
-        SL_CHECK(s.camera_is_orbit && s.orbit.azimuth_deg == -12.5 && s.orbit.distance == 4.0);
+        SL_CHECK(s.camera.is_orbit && s.camera.orbit.azimuth_deg == -12.5 && s.camera.orbit.distance == 4.0);
         const cJSON *r = cJSON_GetObjectItemCaseSensitive(s.params, "radius");
         SL_CHECK(cJSON_IsNumber(r) && r->valuedouble == 0.5);
         sl_scene_deinit(&s);
@@ -442,7 +504,7 @@ static void test_overrides(void)
     st = parse_with("{\"dataset\": \"tornado\", \"camera\": {\"orbit\": {\"azimuth\": 5}}}", sets3, 9, &s, &err);
     SL_CHECK_MSG(st == SL_OK, "%s", err.message);
     if (st == SL_OK) {
-        SL_CHECK(!s.camera_is_orbit && s.camera.eye.x == 1 && s.camera.eye.y == 2 && s.camera.eye.z == 3);
+        SL_CHECK(!s.camera.is_orbit && s.camera.look_at.eye.x == 1 && s.camera.look_at.eye.y == 2 && s.camera.look_at.eye.z == 3);
         SL_CHECK(strcmp(s.technique, "tubes") == 0);
         SL_CHECK(s.width == 320 && s.height == 200);
         SL_CHECK(s.background[0] == 0.0f && s.background[3] == 1.0f);
@@ -747,6 +809,7 @@ int main(void)
     test_valid();
     test_invalid();
     test_nan_in_memory();
+    test_camera_json();
     test_overrides();
     test_open_dataset();
     test_scene_view();

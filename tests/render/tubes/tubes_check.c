@@ -36,6 +36,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_clock.h"
 #include "line_style/sl_line_style.h"
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
@@ -412,9 +413,9 @@ int main(int argc, char **argv)
     sl_tubes_nodes_set_radii(&ds->lines, style.radius_attribute, &nodes);
     tubes_ref_desc rd = {.view = &view, .origin = ds->origin, .nodes = &nodes, .radius = style.radius,
                          .radius_scale = style.radius_scale, .cubic = 0, .samples = o.ref_samples};
-    double t0 = sl_now_ms();
+    double t0 = sl_clock_ms();
     tubes_ref_render(&rd, ref, rad, seg);
-    double ref_ms = sl_now_ms() - t0;
+    double ref_ms = sl_clock_ms() - t0;
     float *cubic = NULL;
     if (o.cubic_ref) {
         cubic = calloc(np, sizeof *cubic);
