@@ -10,6 +10,7 @@
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
+ *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
  *   clock.c    monotonic milliseconds, the one time source (any thread)
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
