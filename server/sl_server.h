@@ -10,6 +10,7 @@
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
+ *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
  * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the

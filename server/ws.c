@@ -9,7 +9,8 @@
  * still sends its own name as Host. WebSocket upgrades are accepted only
  * on path /ws with subprotocol sightline.v1 and an Origin that is absent
  * (non-browser clients), equal to the served origin http://<Host> (Host
- * checked as above) or in the allow-list.
+ * checked as above) or in the allow-list. The rules themselves are pure functions
+ * (http_host.c); this file reads the headers.
  * Incoming messages are reassembled up to SL_PROTO_MAX_HELLO bytes before
  * hello and SL_PROTO_MAX_MESSAGE after; a larger one closes only that
  * connection with 1008 (policy violation). Writes happen only in
@@ -18,6 +19,7 @@
  * as LWS_CALLBACK_EVENT_WAIT_CANCELLED. Never calls GL.
  */
 #include "sl_server.h"
+#include "sl_http_host.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,55 +49,19 @@ static sl_server *server_of(struct lws *wsi)
     return lws_context_user(lws_get_context(wsi));
 }
 
-/* 1 when host is "name:port" (or "name" with port 80) for the listening port. */
-static int host_is(const char *host, const char *name, int port)
+/* The Host / Origin rules' view of this server (sl_http_host.h). */
+static sl_http_site site_of(const sl_server *srv)
 {
-    size_t n = strlen(name);
-    if (strncasecmp(host, name, n) != 0)
-        return 0;
-    if (host[n] == '\0')
-        return port == 80;
-    char want[16];
-    snprintf(want, sizeof want, ":%d", port);
-    return strcmp(host + n, want) == 0;
-}
-
-/* The authority ("host[:port]") of an allow-listed origin URL such as
- * "https://viz.example.org" or "http://10.0.0.5:8080". */
-static int host_of_origin(const char *host, const char *origin)
-{
-    const char *p = strstr(origin, "://");
-    if (!p)
-        return 0;
-    p += 3;
-    size_t n = strcspn(p, "/");
-    return n > 0 && strlen(host) == n && strncasecmp(host, p, n) == 0;
-}
-
-static int host_allowed(sl_server *srv, const char *host)
-{
-    static const char *const local[] = {"localhost", "127.0.0.1", "[::1]"};
-    for (size_t i = 0; i < sizeof local / sizeof local[0]; i++)
-        if (host_is(host, local[i], srv->port))
-            return 1;
-    const char *bind = srv->cfg.bind;
-    if (bind && bind[0]) {
-        char name[300];
-        snprintf(name, sizeof name, strchr(bind, ':') ? "[%s]" : "%s", bind);
-        if (host_is(host, name, srv->port))
-            return 1;
-    }
-    for (int i = 0; i < srv->cfg.origin_count; i++)
-        if (host_of_origin(host, srv->cfg.origins[i]))
-            return 1;
-    return 0;
+    return (sl_http_site){.port = srv->port, .bind = srv->cfg.bind, .origins = srv->cfg.origins,
+                          .origin_count = srv->cfg.origin_count};
 }
 
 /* Host header check for any request (see the file comment). */
 static int request_host_allowed(sl_server *srv, struct lws *wsi)
 {
     char host[256];
-    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0 || !host_allowed(srv, host)) {
+    sl_http_site site = site_of(srv);
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0 || !sl_http_host_allowed(&site, host)) {
         lwsl_notice("refused request for Host \"%s\"\n", lws_hdr_total_length(wsi, WSI_TOKEN_HOST) > 0 ? host : "");
         return 0;
     }
@@ -104,19 +70,15 @@ static int request_host_allowed(sl_server *srv, struct lws *wsi)
 
 static int origin_allowed(sl_server *srv, struct lws *wsi)
 {
-    char origin[256], host[256], served[300];
+    char origin[256] = "", host[256];
     if (!request_host_allowed(srv, wsi))
         return 0;
-    if (lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) <= 0)
-        return 1; /* not a browser: nothing to protect against */
-    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0) {
-        snprintf(served, sizeof served, "http://%s", host);
-        if (strcasecmp(origin, served) == 0)
-            return 1;
-    }
-    for (int i = 0; i < srv->cfg.origin_count; i++)
-        if (strcmp(origin, srv->cfg.origins[i]) == 0)
-            return 1;
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0)
+        return 0;
+    int has_origin = lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) > 0;
+    sl_http_site site = site_of(srv);
+    if (sl_http_origin_allowed(&site, host, has_origin ? origin : NULL))
+        return 1;
     lwsl_notice("refused WebSocket upgrade from origin %s\n", origin);
     return 0;
 }

@@ -5,6 +5,10 @@
  * sl_diff.h and the verdict against the limits given; optionally writes a heat
  * map PNG. The metrics themselves live in renderer/image/diff.c; this file only
  * parses arguments, reads files and formats JSON. Single-threaded.
+ * Colour with --background R,G,B: mean, max, PSNR and bad_pct are over the
+ * covered pixels (either image differs from that colour), so an error on
+ * every drawn pixel of a mostly empty frame is not diluted by the empty part;
+ * the JSON also gives the pixel count and the whole-frame mean and bad_pct.
  * Depth maps: bad_pct counts every coverage mismatch (hit in one map, missed
  * in the other) as a bad pixel, over the pixels either map hits; mean and max
  * are over pixels both hit. When any limit is given for a depth pair and
@@ -43,10 +47,13 @@ enum { LIM_MEAN, LIM_BAD_PCT, LIM_COVERAGE_PCT, LIM_ABS, LIM_COUNT };
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: sightline-diff A B [--diff heat.png] [--bad-threshold T]\n"
+            "usage: sightline-diff A B [--diff heat.png] [--bad-threshold T] [--background R,G,B]\n"
             "                      [--max-mean X] [--max-bad-pct Y] [--max-coverage-pct Z] [--max-abs M]\n"
             "A and B: both PNG (colour, 0..255 units) or both PFM (depth, world units; 0 = no hit).\n"
-            "  mean_abs, max_abs, psnr_db: colour over all pixels; depth over pixels hit in both maps.\n"
+            "  mean_abs, max_abs, psnr_db: colour over the compared pixels; depth over pixels hit in both.\n"
+            "  compared (colour): all pixels, or with --background R,G,B (0..255 each) the covered\n"
+            "    pixels: those whose RGB differs from that colour in A or in B; frame_mean_abs and\n"
+            "    frame_bad_pct are then the same metrics over all pixels.\n"
             "  bad_pct: %% of compared pixels that are bad: difference > T; for depth, compared = pixels\n"
             "    hit in either map and every coverage mismatch (hit in one, missed in the other) is bad.\n"
             "  coverage_mismatch_pct (depth): %% of the pixels hit in either map that only one hits.\n"
@@ -86,6 +93,25 @@ static int parse_number(const char *option, const char *text, double *out)
     return 1;
 }
 
+/* "R,G,B", each an integer in 0..255. */
+static int parse_background(const char *text, uint8_t out[3])
+{
+    const char *p = text;
+    for (int c = 0; c < 3; c++) {
+        char *end = NULL;
+        errno = 0;
+        long v = (*p >= '0' && *p <= '9') ? strtol(p, &end, 10) : -1;
+        if (v < 0 || v > 255 || errno == ERANGE || *end != (c < 2 ? ',' : '\0')) {
+            fprintf(stderr, "sightline-diff: --background needs R,G,B with each an integer in 0..255, got \"%s\"\n",
+                    text);
+            return 0;
+        }
+        out[c] = (uint8_t)v;
+        p = end + 1;
+    }
+    return 1;
+}
+
 static cJSON *add_number(cJSON *obj, const char *name, double v)
 {
     return isfinite(v) ? cJSON_AddNumberToObject(obj, name, v) : cJSON_AddNullToObject(obj, name);
@@ -101,8 +127,9 @@ int main(int argc, char **argv)
     };
     const char *paths[2] = {NULL, NULL};
     const char *heat_path = NULL;
-    int npaths = 0, threshold_set = 0;
+    int npaths = 0, threshold_set = 0, background_set = 0;
     double threshold = 0.0;
+    uint8_t background[3] = {0, 0, 0};
 
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
@@ -126,6 +153,12 @@ int main(int argc, char **argv)
         i++;
         if (strcmp(arg, "--diff") == 0) {
             heat_path = value;
+            continue;
+        }
+        if (strcmp(arg, "--background") == 0) {
+            if (!parse_background(value, background))
+                return EXIT_BAD_INPUT;
+            background_set = 1;
             continue;
         }
         if (strcmp(arg, "--bad-threshold") == 0) {
@@ -174,6 +207,8 @@ int main(int argc, char **argv)
     int depth = kinds[0] == KIND_PFM;
     if (!depth && limits[LIM_COVERAGE_PCT].set)
         fprintf(stderr, "sightline-diff: note: --max-coverage-pct applies to depth maps only; ignored for PNG\n");
+    if (depth && background_set)
+        fprintf(stderr, "sightline-diff: note: --background applies to colour images only; ignored for PFM\n");
     if (!threshold_set)
         threshold = depth ? 1e-3 : 8.0;
     /* A depth limit without a coverage limit must not pass maps that hit
@@ -204,7 +239,8 @@ int main(int argc, char **argv)
     }
     if (st == SL_OK)
         st = depth ? sl_diff_depths(&dep[0], &dep[1], threshold, &r, heat_path ? &heat : NULL, &err)
-                   : sl_diff_images(&img[0], &img[1], threshold, &r, heat_path ? &heat : NULL, &err);
+                   : sl_diff_images_covered(&img[0], &img[1], threshold, background_set ? background : NULL, &r,
+                                            heat_path ? &heat : NULL, &err);
     if (st == SL_OK && heat_path)
         st = sl_png_write(heat_path, heat, r.width, r.height, &err);
     if (st != SL_OK) {
@@ -228,6 +264,18 @@ int main(int argc, char **argv)
     add_number(json, "bad_pct", r.bad_pct);
     cJSON_AddNumberToObject(json, "bad_count", (double)r.bad_count);
     cJSON_AddNumberToObject(json, "compared", (double)r.compared);
+    cJSON_AddNumberToObject(json, "pixels", (double)r.pixels);
+    if (!depth && background_set) {
+        cJSON *bg = cJSON_AddArrayToObject(json, "background");
+        for (int c = 0; c < 3 && bg; c++)
+            cJSON_AddItemToArray(bg, cJSON_CreateNumber(background[c]));
+        cJSON_AddNumberToObject(json, "covered", (double)r.compared);
+        add_number(json, "frame_mean_abs", r.frame_mean_abs);
+        add_number(json, "frame_bad_pct", r.frame_bad_pct);
+        if (r.compared == r.pixels)
+            fprintf(stderr, "sightline-diff: note: no pixel is background %d,%d,%d in both images; "
+                            "every pixel is compared\n", background[0], background[1], background[2]);
+    }
     if (depth) {
         cJSON_AddNumberToObject(json, "both_hit", (double)r.both_hit);
         cJSON_AddNumberToObject(json, "coverage_mismatch", (double)r.coverage_mismatch);

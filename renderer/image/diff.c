@@ -1,8 +1,11 @@
 /* diff.c — colour and depth image comparison (see sl_diff.h); the engine of sightline-diff.
  *
  * Colour: d = max over R, G, B of |a - b| (alpha ignored); mean/max of d over
- * all pixels; PSNR = 10 log10(255^2 / MSE) with MSE over the R, G, B samples
- * (INFINITY when MSE = 0); bad = pixels with d > bad_threshold.
+ * the compared pixels: all, or with a background colour the covered ones (RGB
+ * of a or of b differs from it); PSNR = 10 log10(255^2 / MSE) with MSE over
+ * their R, G, B samples (INFINITY when MSE = 0); bad = compared pixels with
+ * d > bad_threshold. An uncovered pixel equals the background in both images,
+ * so d = 0 there: the whole-frame mean is reported too (frame_mean_abs).
  * Depth: a pixel is hit when its value is finite and > 0. mean, max and PSNR
  * are over pixels hit in both (a difference is only defined there); bad
  * pixels are those hit in both with d > bad_threshold plus every coverage
@@ -54,8 +57,19 @@ static double heat_scale(double max_abs, double bad_threshold)
     return s > 0.0 ? s : 1.0;
 }
 
+static int is_background(const uint8_t *px, const uint8_t *background)
+{
+    return px[0] == background[0] && px[1] == background[1] && px[2] == background[2];
+}
+
 sl_status sl_diff_images(const sl_image *a, const sl_image *b, double bad_threshold,
                          sl_diff_result *out, uint8_t **heat, sl_err *err)
+{
+    return sl_diff_images_covered(a, b, bad_threshold, NULL, out, heat, err);
+}
+
+sl_status sl_diff_images_covered(const sl_image *a, const sl_image *b, double bad_threshold,
+                                 const uint8_t *background, sl_diff_result *out, uint8_t **heat, sl_err *err)
 {
     if (heat)
         *heat = NULL;
@@ -70,9 +84,12 @@ sl_status sl_diff_images(const sl_image *a, const sl_image *b, double bad_thresh
     size_t n = (size_t)a->width * (size_t)a->height;
     double sum = 0.0, sq = 0.0;
     int max_d = 0;
-    long bad = 0;
+    long bad = 0, covered = 0;
     for (size_t i = 0; i < n; i++) {
         const uint8_t *pa = a->rgba + i * 4, *pb = b->rgba + i * 4;
+        if (background && is_background(pa, background) && is_background(pb, background))
+            continue;
+        covered++;
         int d = 0;
         for (int c = 0; c < 3; c++) {
             int e = abs((int)pa[c] - (int)pb[c]);
@@ -89,13 +106,16 @@ sl_status sl_diff_images(const sl_image *a, const sl_image *b, double bad_thresh
     memset(out, 0, sizeof *out);
     out->width = a->width;
     out->height = a->height;
-    out->compared = out->both_hit = (long)n;
-    out->mean_abs = sum / (double)n;
+    out->pixels = (long)n;
+    out->compared = out->both_hit = covered;
+    out->mean_abs = covered ? sum / (double)covered : 0.0;
     out->max_abs = max_d;
-    double mse = sq / (3.0 * (double)n);
+    double mse = covered ? sq / (3.0 * (double)covered) : 0.0;
     out->psnr_db = mse > 0.0 ? 10.0 * log10(255.0 * 255.0 / mse) : INFINITY;
     out->bad_count = bad;
-    out->bad_pct = 100.0 * (double)bad / (double)n;
+    out->bad_pct = covered ? 100.0 * (double)bad / (double)covered : 0.0;
+    out->frame_mean_abs = sum / (double)n;
+    out->frame_bad_pct = 100.0 * (double)bad / (double)n;
 
     if (heat) {
         uint8_t *h = malloc(n * 4);
@@ -166,6 +186,7 @@ sl_status sl_diff_depths(const sl_depth_image *a, const sl_depth_image *b, doubl
     memset(out, 0, sizeof *out);
     out->width = a->width;
     out->height = a->height;
+    out->pixels = (long)n;
     out->compared = either;
     out->both_hit = both;
     out->mean_abs = both ? sum / (double)both : 0.0;

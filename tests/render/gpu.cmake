@@ -2,7 +2,7 @@
 # and the sightline-render command line checks that happen before rendering
 # (tools/sightline_render.c). Each test runs sightline-render in a fresh
 # process (the EGL environment variables act at driver load) through the step
-# runner tests/render/tubes_mesh/steps.cmake, and names the exact exit code
+# runner tests/steps.cmake, and names the exact exit code
 # (1 usage, 2 bad input, 3 GPU) and a stderr regex, so a crash or a sanitizer
 # report cannot pass for an expected failure. The in-process candidate loop
 # (fallback from a failing candidate, explicit choices not falling back) is
@@ -11,7 +11,7 @@ set(GPU_OUT ${SL_RENDER_OUT}/gpu)
 file(MAKE_DIRECTORY ${GPU_OUT})
 set(GPU_RENDER $<TARGET_FILE:sightline-render>)
 set(GPU_DIFF $<TARGET_FILE:sightline-diff>)
-set(GPU_STEPS -P ${CMAKE_CURRENT_SOURCE_DIR}/tubes_mesh/steps.cmake)
+set(GPU_STEPS ${SL_STEPS})
 set(GPU_TINY ${CMAKE_CURRENT_SOURCE_DIR}/tubes_mesh/tiny.json)
 
 # gpu_case(NAME name EXIT code ERR regex [OUT regex] [ENV VAR=value ...] ARGS sightline-render args...)
@@ -113,5 +113,5 @@ sl_add_render_test(NAME cli.orbit_frames COMMAND ${CMAKE_COMMAND}
   "-DSTEP3=${GPU_DIFF}|${GPU_OUT}/orbit_f2.png|${GPU_OUT}/orbit_az190.png|--max-abs|0"
   "-DSTEP4=${GPU_RENDER}|${orbit_args}|--set|orbit_frames=4|--frames|1|--out|${GPU_OUT}/orbit_f0.png"
   "-DSTEP5=${GPU_DIFF}|${GPU_OUT}/orbit_f0.png|${GPU_OUT}/orbit_f2.png|--max-abs|0"
-  -DEXIT5=1 "-DOUT5=\"pass\":[ \t]*false"
+  -DEXIT5=1 "-DOUT5=\"failed\":[ \t]*\\[\"max_abs\"\\]"
   ${GPU_STEPS})

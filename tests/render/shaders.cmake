@@ -13,15 +13,15 @@ sl_add_render_test(NAME shaders.detects_compile_error
   COMMAND ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:shaders-check>|--file|${CMAKE_CURRENT_SOURCE_DIR}/shaders/broken.frag.glsl"
   -DEXIT1=1 "-DERR1=FAIL [^\n]*broken\\.frag\\.glsl \\(fragment shader\\)[^\n]*\n  [^\n]*broken\\.frag\\.glsl:11[^\n]*error"
-  -P ${CMAKE_CURRENT_SOURCE_DIR}/tubes_mesh/steps.cmake)
+  ${SL_STEPS})
 sl_add_render_test(NAME shaders.detects_missing_include
   COMMAND ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:shaders-check>|--file|${CMAKE_CURRENT_SOURCE_DIR}/shaders/missing_include.vert.glsl"
   -DEXIT1=1 "-DERR1=missing_include\\.vert\\.glsl:3: #include \"gpu/glsl/no_such_file\\.glsl\": no such embedded file"
-  -P ${CMAKE_CURRENT_SOURCE_DIR}/tubes_mesh/steps.cmake)
+  ${SL_STEPS})
 sl_add_render_test(NAME shaders.detects_variant_error
   COMMAND ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:shaders-check>|--file|${CMAKE_CURRENT_SOURCE_DIR}/shaders/broken_variant.comp.glsl"
   -DEXIT1=1 "-DERR1=FAIL [^\n]*broken_variant\\.comp\\.glsl \\(compute shader, MODE=2 \\)[^\n]*\n  [^\n]*broken_variant\\.comp\\.glsl:12[^\n]*undeclared_value"
   "-DOUT1=ok   [^\n]*broken_variant\\.comp\\.glsl +compute +MODE=1"
-  -P ${CMAKE_CURRENT_SOURCE_DIR}/tubes_mesh/steps.cmake)
+  ${SL_STEPS})

@@ -2,7 +2,9 @@
 # double-precision reference (tests/render/tubes/tubes_reference.c) on random
 # and degenerate Hermite segment sets, through the pipeline (tubes-check) and
 # through `sightline-render --depth` + `sightline-diff`; golden images.
-# Scenes and goldens live in tests/render/tubes/.
+# Scenes and goldens live in tests/render/tubes/; chained commands run through
+# the step runner (SL_STEPS, tests/steps.cmake), and every test that
+# expects a failure names its exit code and its failure line.
 #
 # Bound (every accuracy test): on pixels both hit, |depth error| <= 1e-3 x the
 # local sweep radius; exceptions only at reference silhouettes (coverage change
@@ -101,7 +103,7 @@ tubes_render_test(prepass.same_frame_dense
   "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_off.png|--depth|${TUBES_OUT}/dense_off.pfm|--samples|1|--set|params.occlusion_prepass=off"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.pfm|${TUBES_OUT}/dense_off.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.png|${TUBES_OUT}/dense_off.png|--max-bad-pct|0.1"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 # With 4 MSAA samples the pre-pass renders the single-sample frame into every sample.
 tubes_render_test(prepass.msaa_same_as_single
   ${CMAKE_COMMAND}
@@ -109,7 +111,7 @@ tubes_render_test(prepass.msaa_same_as_single
   "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms1.png|--depth|${TUBES_OUT}/dense_ms1.pfm|--samples|1|--set|params.occlusion_prepass=on"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.pfm|${TUBES_OUT}/dense_ms1.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.png|${TUBES_OUT}/dense_ms1.png|--max-abs|1"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 # Folds: segments whose curve runs past their end and returns inside their own tube,
 # exactly collinear (axis-aligned and seeded directions) and nearly so (first tangent
 # tilted by 1e-7 to 1e-2 of its length). Two faults lived here: the box frame took
@@ -148,31 +150,38 @@ tubes_render_test(accuracy.radius_attribute
   ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/radius_attribute.json|--out|${TUBES_OUT}/radius_attribute.png|--depth|${TUBES_OUT}/radius_attribute.pfm|--samples|1"
   "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/radius_attribute_ref.json|--gpu-depth|${TUBES_OUT}/radius_attribute.pfm"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 # An attribute index the dataset lacks is an error naming the parameter and
 # the number of attributes (explicit Hermite data has 3: scalar,
 # scalar_derivative, radius_derivative), not a silent constant colour.
+# Exit 2 (bad input) and that message; a warning with a rendered frame, or a
+# crash after the message, fails.
 foreach(param attribute radius_attribute)
   tubes_render_test(bad_${param}
-    $<TARGET_FILE:sightline-render> --scene ${TUBES_DIR}/varying_radius.json --out ${TUBES_OUT}/bad_${param}.png
-    --set params.${param}=3)
-  set_tests_properties(render.tubes.bad_${param} PROPERTIES
-    PASS_REGULAR_EXPRESSION "params\\.${param} = 3: the dataset has 3 per-vertex attributes")
+    ${CMAKE_COMMAND}
+    "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/varying_radius.json|--out|${TUBES_OUT}/bad_${param}.png|--set|params.${param}=3"
+    -DEXIT1=2 "-DERR1=sightline-render: [^\n]*params\\.${param} = 3: the dataset has 3 per-vertex attributes"
+    ${SL_STEPS})
 endforeach()
 
-# The checks can fail (EXPECT_FAIL_STEP: that step must exit 1, "check failed"):
-# a radius 0.15 % too large, rendered by sightline-render and checked against
-# the reference of the scene as it is, and a single root-search step.
+# The checks can fail (tubes-check exits 1 and prints its summary line and
+# FAIL, with depth errors listed; bad input would be 2, a crash or sanitizer
+# report fails the step runner): a radius 0.15 % too large, rendered by
+# sightline-render and checked against the reference of the scene as it is,
+# and a single root-search step.
+set(TUBES_CHECK_FAILED "tubes-check [^\n]*: [0-9]+ pixels both hit; [^\n]*; failures [1-9][0-9]*; non-finite 0; [^\n]*\nFAIL\n")
 tubes_render_test(detects.radius_scale_1_0015
   ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/varying_radius.json|--out|${TUBES_OUT}/vr_thick.png|--depth|${TUBES_OUT}/vr_thick.pfm|--samples|1|--set|params.radius_scale=1.0015"
   "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--gpu-depth|${TUBES_OUT}/vr_thick.pfm"
-  -DEXPECT_FAIL_STEP=2 -P ${TUBES_DIR}/run_steps.cmake)
+  -DEXIT2=1 "-DOUT2=${TUBES_CHECK_FAILED}" "-DERR2=(^|\n)  pixel \\([0-9]+,[0-9]+\\): gpu "
+  ${SL_STEPS})
 foreach(method bisection illinois newton)
   tubes_render_test(detects.iterations_1_${method}
     ${CMAKE_COMMAND}
     "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--set|params.iterations=1|--set|params.root_method=${method}"
-    -DEXPECT_FAIL_STEP=1 -P ${TUBES_DIR}/run_steps.cmake)
+    -DEXIT1=1 "-DOUT1=${TUBES_CHECK_FAILED}" "-DERR1=(^|\n)  pixel \\([0-9]+,[0-9]+\\): gpu "
+    ${SL_STEPS})
 endforeach()
 
 # The command-line path of the issue: sightline-render --depth, then the
@@ -183,7 +192,7 @@ tubes_render_test(accuracy.tornado_cli
   "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/tornado.json|--out|${TUBES_OUT}/tornado.png|--depth|${TUBES_OUT}/tornado_gpu.pfm|--samples|1"
   "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/tornado.json|--gpu-depth|${TUBES_OUT}/tornado_gpu.pfm|--out-ref|${TUBES_OUT}/tornado_ref.pfm"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/tornado_gpu.pfm|${TUBES_OUT}/tornado_ref.pfm|--bad-threshold|1e-5|--max-bad-pct|0.5|--max-coverage-pct|0.5"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 
 # The same with data radii (1.2-2.5 x the segment length, smallest ~0.024):
 # absolute bound 1e-3 x 0.024 for sightline-diff; tubes-check uses the local radius.
@@ -192,7 +201,7 @@ tubes_render_test(accuracy.hotroom_cli
   "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/hotroom.json|--out|${TUBES_OUT}/hotroom.png|--depth|${TUBES_OUT}/hotroom_gpu.pfm|--samples|1"
   "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/hotroom.json|--gpu-depth|${TUBES_OUT}/hotroom_gpu.pfm|--out-ref|${TUBES_OUT}/hotroom_ref.pfm"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/hotroom_gpu.pfm|${TUBES_OUT}/hotroom_ref.pfm|--bad-threshold|2.4e-5|--max-bad-pct|0.5|--max-coverage-pct|0.5"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 
 # Every stress scene (and a random set, written out by tubes-check
 # --write-scene) through the command-line path as well: sightline-render
@@ -211,7 +220,7 @@ foreach(pair stress_zero_length:1e-4 stress_zero_tangents:1e-4 stress_collinear:
     "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/${name}.json|--out|${TUBES_OUT}/${name}_cli.png|--depth|${TUBES_OUT}/${name}_gpu.pfm|--samples|1"
     "-DSTEP2=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/${name}.json|--gpu-depth|${TUBES_OUT}/${name}_gpu.pfm|--out-ref|${TUBES_OUT}/${name}_ref.pfm"
     "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}_gpu.pfm|${TUBES_OUT}/${name}_ref.pfm|--bad-threshold|${bound}|--max-bad-pct|0.5|--max-coverage-pct|0.5"
-    -P ${TUBES_DIR}/run_steps.cmake)
+    ${SL_STEPS})
 endforeach()
 # A random set (radii 0.03-0.12): the scene as tubes-check builds it, rendered by sightline-render.
 tubes_render_test(accuracy.random_1_cli
@@ -220,15 +229,29 @@ tubes_render_test(accuracy.random_1_cli
   "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_OUT}/random_1_scene.json|--out|${TUBES_OUT}/random_1_cli.png|--depth|${TUBES_OUT}/random_1_gpu.pfm|--samples|1"
   "-DSTEP3=$<TARGET_FILE:tubes-check>|--scene|${TUBES_OUT}/random_1_scene.json|--gpu-depth|${TUBES_OUT}/random_1_gpu.pfm"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/random_1_gpu.pfm|${TUBES_OUT}/random_1_ref.pfm|--bad-threshold|3e-5|--max-bad-pct|0.5|--max-coverage-pct|0.5"
-  -P ${TUBES_DIR}/run_steps.cmake)
+  ${SL_STEPS})
 
-# Golden images (128x128, llvmpipe): mean colour difference <= 1 and at most
-# 0.5 % of pixels off by more than 8 (of 255). Regenerate with
+# Golden images (128x128, llvmpipe), over the covered pixels (either image
+# differs from the background, SL_GOLDEN_BACKGROUND): mean colour difference
+# <= 1 and at most 0.5 % of them off by more than 8 (of 255). Regenerate with
 #   tubes-check --scene S.json --out-png tests/render/tubes/golden/S.png
+set(TUBES_GOLDEN_LIMITS --max-mean 1 --max-bad-pct 0.5 ${SL_GOLDEN_BACKGROUND})
+string(REPLACE ";" "|" TUBES_GOLDEN_ARGS "${TUBES_GOLDEN_LIMITS}")
 foreach(name bifurcation sharp_corner varying_radius)
   tubes_render_test(golden.${name}
     ${CMAKE_COMMAND}
     "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/${name}.json|--out-png|${TUBES_OUT}/${name}.png"
-    "-DSTEP2=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}.png|${TUBES_DIR}/golden/${name}.png|--max-mean|1|--max-bad-pct|0.5|--diff|${TUBES_OUT}/${name}_heat.png"
-    -P ${TUBES_DIR}/run_steps.cmake)
+    "-DSTEP2=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}.png|${TUBES_DIR}/golden/${name}.png|${TUBES_GOLDEN_ARGS}|--diff|${TUBES_OUT}/${name}_heat.png"
+    ${SL_STEPS})
 endforeach()
+# The limits catch a uniform error: +5 on every drawn pixel of the
+# bifurcation golden (17 % of the frame drawn) is a covered mean of 5, over 1;
+# over the whole frame it was 0.87 with no pixel over 8, and passed (step 2).
+tubes_render_test(golden.detects_uniform_error
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:golden-offset>|${TUBES_DIR}/golden/bifurcation.png|${TUBES_OUT}/bifurcation_plus5.png|26,26,31|5"
+  "-DSTEP2=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/bifurcation_plus5.png|${TUBES_DIR}/golden/bifurcation.png|--max-mean|1|--max-bad-pct|0.5"
+  "-DOUT2=\"pass\":[ \t]*true"
+  "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/bifurcation_plus5.png|${TUBES_DIR}/golden/bifurcation.png|${TUBES_GOLDEN_ARGS}"
+  -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_mean\"\\]"
+  ${SL_STEPS})

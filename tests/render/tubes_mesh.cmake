@@ -1,10 +1,10 @@
 # GPU tests of the `tubes_mesh` technique (renderer/tubes_mesh/) and of the
-# sightline-render / sightline-diff command lines. Scenes, goldens, the check
-# program (tubes_mesh_check.c) and the step runner (steps.cmake: each step's
-# exact exit code and stderr/stdout regexes) live in tests/render/tubes_mesh/.
-# Every test that expects a failure names the exit code (1 = over a limit,
-# 2 = bad input) so that a crash, a sanitizer report or a usage error cannot
-# pass for it. Keep '[' and ']' balanced inside every argument: CMake does not
+# sightline-render / sightline-diff command lines. Scenes, goldens and the
+# check program (tubes_mesh_check.c) live in tests/render/tubes_mesh/; the
+# step runner (SL_STEPS: each step's exact exit code and stderr/stdout
+# regexes) is tests/steps.cmake. Every test that expects a failure
+# names the exit code (1 = over a limit, 2 = bad input) and the failure line,
+# so that a crash, a sanitizer report or a usage error cannot pass for it. Keep '[' and ']' balanced inside every argument: CMake does not
 # split a list at ';' inside an open bracket, so an unbalanced one would
 # swallow the following "-P steps.cmake" and turn the test into an in-source
 # configure of the working directory.
@@ -19,16 +19,18 @@ set_target_properties(tubes-mesh-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMA
 set(TM_RENDER $<TARGET_FILE:sightline-render>)
 set(TM_DIFF $<TARGET_FILE:sightline-diff>)
 set(TM_CHECK $<TARGET_FILE:tubes-mesh-check>)
-set(TM_STEPS -P ${TM_DIR}/steps.cmake)
+set(TM_STEPS ${SL_STEPS})
 
-# Golden-image tolerance (colour, 0..255). llvmpipe is deterministic, so the
-# same build reproduces a golden exactly (measured: mean 0, 0 bad pixels);
-# the slack is for other Mesa/LLVM versions and CPUs: shading may move by an
-# LSB or two everywhere (mean <= 0.5) and MSAA edge coverage may flip on a
-# few silhouette pixels (<= 0.5 % of pixels off by more than 16). A real
-# change — a 30-degree camera turn (cli.set_changes_image), a different
-# tessellation, colormap or radius — is far beyond it.
-set(TM_GOLDEN_LIMITS --max-mean 0.5 --max-bad-pct 0.5 --bad-threshold 16)
+# Golden-image tolerance (colour, 0..255), over the covered pixels (either
+# image differs from the background; SL_GOLDEN_BACKGROUND). llvmpipe is
+# deterministic, so the same build reproduces a golden exactly (measured:
+# mean 0, 0 bad pixels); the slack is for other Mesa/LLVM versions and CPUs:
+# shading may move by an LSB or two on the tubes (mean <= 0.5) and MSAA edge
+# coverage may flip on a few silhouette pixels (<= 0.5 % of the covered
+# pixels off by more than 16). A real change — a 30-degree camera turn
+# (cli.set_changes_image), a different tessellation, colormap or radius, or
+# +5 on every drawn pixel (golden.detects_uniform_error) — is far beyond it.
+set(TM_GOLDEN_LIMITS --max-mean 0.5 --max-bad-pct 0.5 --bad-threshold 16 ${SL_GOLDEN_BACKGROUND})
 string(REPLACE ";" "|" TM_GOLDEN_ARGS "${TM_GOLDEN_LIMITS}")
 
 function(tm_test name)
@@ -65,6 +67,16 @@ tm_golden(hotroom hotroom.json)
 tm_golden(caps_sides6 cylinder_oblique.json --set params.sides=6)
 tm_golden(open_sides6 cylinder_oblique.json --set params.sides=6 --set params.caps=false)
 tm_golden(degenerate_obj degenerate_obj.json)
+# The limits catch a uniform error: +5 on every drawn pixel of the
+# degenerate_obj golden (7 % of the frame drawn) is a covered mean of 5, over
+# 0.5; over the whole frame it was 0.35 and passed (step 2 shows it).
+tm_test(golden.detects_uniform_error ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:golden-offset>|${TM_DIR}/golden/degenerate_obj.png|${TM_OUT}/golden_plus5.png|26,26,31|5"
+  "-DSTEP2=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/golden/degenerate_obj.png|--max-mean|0.5|--max-bad-pct|0.5|--bad-threshold|16"
+  "-DOUT2=\"pass\":[ \t]*true"
+  "-DSTEP3=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/golden/degenerate_obj.png|${TM_GOLDEN_ARGS}"
+  -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_mean\"\\]"
+  ${TM_STEPS})
 
 # ---- 3. accuracy against the exact ray-cylinder distance (tubes-mesh-check cylinder,
 # in double, rays from proto/scene.md). The mesh is a prism inscribed in the
@@ -256,4 +268,4 @@ tm_test(radius_attribute_changes_depth ${CMAKE_COMMAND}
   "-DSTEP1=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute_ref.json|--set|technique=tubes_mesh|--out|${TM_OUT}/rb_ref.png|--depth|${TM_OUT}/rb_ref.pfm"
   "-DSTEP2=${TM_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/tubes/radius_attribute.json|--set|technique=tubes_mesh|--set|params.radius_attribute=-1|--out|${TM_OUT}/rb_attr.png|--depth|${TM_OUT}/rb_attr.pfm"
   "-DSTEP3=${TM_DIFF}|${TM_OUT}/rb_attr.pfm|${TM_OUT}/rb_ref.pfm|--max-abs|1e-4|--max-coverage-pct|0"
-  -DEXIT3=1 ${TM_STEPS})
+  -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[[^]]*\"max_abs\"" ${TM_STEPS})

@@ -2,7 +2,7 @@
  *
  * Metrics are checked on constructed images whose answers are known in closed
  * form (one pixel off by 40, a constant offset of 10, hand-placed coverage
- * holes) and on random images against an independent brute-force reference
+ * holes, +5 on every drawn pixel of a mostly background frame) and on random images against an independent brute-force reference
  * in double (bound: 1e-9 relative). The tool is run as a process from
  * $SIGHTLINE_BINARY_DIR/bin/sightline-diff: exit codes 0/1/2 and its JSON are
  * checked. Temporary files go to a mkdtemp folder under /tmp. Single-threaded.
@@ -134,6 +134,62 @@ static void test_colour_identical_and_offset(void)
     SL_CHECK(sl_diff_images(&a, &b, NAN, &r, NULL, &err) == SL_ERR_INVALID);
     sl_image empty = {0};
     SL_CHECK(sl_diff_images(&a, &empty, 8.0, &r, NULL, &err) == SL_ERR_INVALID);
+    sl_image_deinit(&a);
+    sl_image_deinit(&b);
+    sl_image_deinit(&c);
+}
+
+/* Covered pixels (a background colour given): a 10x10 frame of background
+ * with 10 drawn pixels, +5 on each in b: the whole-frame mean is 0.5, the
+ * covered mean 5. A pixel drawn in one image only is covered; a pixel equal
+ * to the background in both is not, even where the other channels of the
+ * background would be close. */
+static void test_colour_covered(void)
+{
+    enum { W = 10, H = 10, N = W * H };
+    static const uint8_t bg[3] = {26, 26, 31};
+    sl_image a = make_image(W, H, 0), b = make_image(W, H, 0);
+    for (int i = 0; i < N; i++)
+        for (int c = 0; c < 3; c++)
+            a.rgba[i * 4 + c] = b.rgba[i * 4 + c] = bg[c];
+    for (int k = 0; k < 10; k++) {
+        for (int c = 0; c < 3; c++) {
+            a.rgba[(7 * k) * 4 + c] = 100;
+            b.rgba[(7 * k) * 4 + c] = 105;
+        }
+    }
+    sl_diff_result r;
+    sl_err err = {0};
+    SL_CHECK(sl_diff_images_covered(&a, &b, 4.0, bg, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.compared == 10 && r.both_hit == 10 && r.pixels == N);
+    SL_CHECK_NEAR(r.mean_abs, 5.0, 1e-12);
+    SL_CHECK_NEAR(r.frame_mean_abs, 0.5, 1e-12);
+    SL_CHECK(r.bad_count == 10);
+    SL_CHECK_NEAR(r.bad_pct, 100.0, 1e-12);
+    SL_CHECK_NEAR(r.frame_bad_pct, 10.0, 1e-12);
+    SL_CHECK_NEAR(r.psnr_db, 20.0 * log10(255.0 / 5.0), 1e-9);
+    /* Without a background: the whole frame, as sl_diff_images. */
+    SL_CHECK(sl_diff_images_covered(&a, &b, 4.0, NULL, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.compared == N);
+    SL_CHECK_NEAR(r.mean_abs, 0.5, 1e-12);
+    SL_CHECK_NEAR(r.bad_pct, 10.0, 1e-12);
+    SL_CHECK(sl_diff_images(&a, &b, 4.0, &r, NULL, &err) == SL_OK && r.compared == N);
+    /* Drawn in b only (a missing line): covered, off by |100 - 26| = 74 in R. */
+    for (int c = 0; c < 3; c++)
+        b.rgba[(5 * W + 5) * 4 + c] = 100;
+    SL_CHECK(sl_diff_images_covered(&a, &b, 4.0, bg, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.compared == 11 && r.max_abs == 74.0);
+    /* Both all background: nothing compared, a pass with mean 0. */
+    sl_image c = make_image(W, H, 0);
+    for (int i = 0; i < N; i++)
+        for (int k = 0; k < 3; k++)
+            c.rgba[i * 4 + k] = bg[k];
+    SL_CHECK(sl_diff_images_covered(&c, &c, 4.0, bg, &r, NULL, &err) == SL_OK);
+    SL_CHECK(r.compared == 0 && r.mean_abs == 0.0 && r.bad_pct == 0.0 && isinf(r.psnr_db) && r.pixels == N);
+    /* One channel off the background (alpha does not count) is covered. */
+    c.rgba[3] = 0;
+    c.rgba[4 + 2] = 32;
+    SL_CHECK(sl_diff_images_covered(&c, &c, 4.0, bg, &r, NULL, &err) == SL_OK && r.compared == 1);
     sl_image_deinit(&a);
     sl_image_deinit(&b);
     sl_image_deinit(&c);
@@ -355,6 +411,33 @@ static void test_tool(void)
     SL_CHECK_NEAR(json_number(j, "bad_threshold"), 50.0, 0.0);
     cJSON_Delete(j);
 
+    /* --background 100,100,100 (a's colour everywhere): only the one pixel b
+     * changed is covered, so the mean over covered pixels is its 40. */
+    snprintf(args, sizeof args, "%s/a.png %s/b.png --background 100,100,100 --max-mean 39", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 1);
+    SL_CHECK(j && json_has_failed(j, "max_mean"));
+    SL_CHECK_NEAR(json_number(j, "mean_abs"), 40.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "covered"), 1.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "compared"), 1.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "pixels"), 200.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "frame_mean_abs"), 40.0 / 200.0, 1e-12);
+    SL_CHECK_NEAR(json_number(j, "bad_pct"), 100.0, 0.0);
+    SL_CHECK_NEAR(json_number(j, "frame_bad_pct"), 0.5, 1e-12);
+    const cJSON *bgj = cJSON_GetObjectItemCaseSensitive(j, "background");
+    SL_CHECK(cJSON_IsArray(bgj) && cJSON_GetArraySize(bgj) == 3 && cJSON_GetArrayItem(bgj, 2)->valuedouble == 100.0);
+    cJSON_Delete(j);
+    /* Without it the same pair passes --max-mean 39 (40 / 200 pixels). */
+    snprintf(args, sizeof args, "%s/a.png %s/b.png --max-mean 39", tmpdir, tmpdir);
+    SL_CHECK(run_tool(args, &j) == 0);
+    SL_CHECK(j && cJSON_GetObjectItemCaseSensitive(j, "covered") == NULL);
+    cJSON_Delete(j);
+    const char *bad_backgrounds[] = {"1,2", "1,2,3,4", "1,2,256", "-1,2,3", "a,b,c", "1,,3", "1, 2,3", ""};
+    for (size_t k = 0; k < sizeof bad_backgrounds / sizeof bad_backgrounds[0]; k++) {
+        snprintf(args, sizeof args, "%s/a.png %s/b.png --background '%s'", tmpdir, tmpdir, bad_backgrounds[k]);
+        SL_CHECK_MSG(run_tool(args, &j) == 2 && j == NULL, "--background '%s' must be bad usage", bad_backgrounds[k]);
+        cJSON_Delete(j);
+    }
+
     /* Depth: kind by magic bytes (the names end in .pfm, but that is not what counts). */
     snprintf(args, sizeof args, "%s/a.pfm %s/b.pfm --max-coverage-pct 1", tmpdir, tmpdir);
     SL_CHECK(run_tool(args, &j) == 1);
@@ -470,6 +553,7 @@ int main(void)
     test_colour_one_pixel();
     test_colour_identical_and_offset();
     test_colour_random_reference();
+    test_colour_covered();
     test_depth();
     test_tool();
     char cmd[128];
