@@ -75,7 +75,13 @@ static int origin_allowed(sl_server *srv, struct lws *wsi)
         return 0;
     if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0)
         return 0;
-    int has_origin = lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) > 0;
+    /* A present Origin that does not fit the buffer is foreign, never "absent"
+     * (a long hostile domain must not pass as a non-browser client). */
+    int has_origin = lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) > 0;
+    if (has_origin && lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN) <= 0) {
+        lwsl_notice("refused WebSocket upgrade: Origin of %d bytes\n", lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN));
+        return 0;
+    }
     sl_http_site site = site_of(srv);
     if (sl_http_origin_allowed(&site, host, has_origin ? origin : NULL))
         return 1;

@@ -117,10 +117,15 @@ static void check_camera(const cJSON *camera)
     sl_err err = {0};
     for (int b = 0; b < 2; b++) {
         const double (*box)[3] = b ? bounds : NULL;
-        sl_status st = sl_msg_camera_check(camera, box, &err);
+        sl_camera_spec spec, again;
+        sl_status st = sl_msg_camera_check(camera, box, &spec, &err);
         if (st != SL_OK && (st != SL_ERR_INVALID || !err.message[0]))
             abort();
-        if (st == SL_OK && sl_msg_camera_check(camera, box, &err) != SL_OK)
+        /* Accepted once, accepted again, to the same camera (compared field by field). */
+        if (st == SL_OK && (sl_msg_camera_check(camera, box, &again, &err) != SL_OK || spec.is_orbit != again.is_orbit ||
+                            memcmp(spec.is_orbit ? (const void *)&spec.orbit : (const void *)&spec.look_at,
+                                   spec.is_orbit ? (const void *)&again.orbit : (const void *)&again.look_at,
+                                   spec.is_orbit ? sizeof spec.orbit : sizeof spec.look_at) != 0))
             abort();
     }
 }

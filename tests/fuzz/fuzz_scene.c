@@ -54,15 +54,16 @@ static void check_scene(sl_status st, sl_scene *s, const sl_err *err)
     for (int k = 0; k < 4; k++)
         if (!(s->background[k] >= 0.0f && s->background[k] <= 1.0f))
             abort();
-    if (s->orbit_frames < 0 || s->orbit_frames > 1000000 || (s->orbit_frames > 0 && !s->camera_is_orbit))
+    if (s->orbit_frames < 0 || s->orbit_frames > 1000000 || (s->orbit_frames > 0 && !s->camera.is_orbit))
         abort();
     sl_err cerr = {0};
-    if (s->camera_is_orbit) {
-        if (!(s->orbit.distance > 0.0) || !isfinite(s->orbit.distance) || !isfinite(s->orbit.azimuth_deg) ||
-            !(fabs(s->orbit.elevation_deg) <= SL_ORBIT_MAX_ELEVATION) ||
-            !(s->orbit.fov_y_deg > 0.0 && s->orbit.fov_y_deg < 180.0))
+    const sl_orbit *orbit = &s->camera.orbit;
+    if (s->camera.is_orbit) {
+        if (!(orbit->distance > 0.0) || !isfinite(orbit->distance) || !isfinite(orbit->azimuth_deg) ||
+            !(fabs(orbit->elevation_deg) <= SL_ORBIT_MAX_ELEVATION) ||
+            !(orbit->fov_y_deg > 0.0 && orbit->fov_y_deg < 180.0))
             abort();
-    } else if (sl_camera_validate(&s->camera, &cerr) != SL_OK) {
+    } else if (sl_camera_validate(&s->camera.look_at, &cerr) != SL_OK) {
         abort();
     }
 

@@ -492,6 +492,13 @@ int main(void)
     SL_CHECK(upgrade_with(h.port, hostport, NULL) != 0);
     SL_CHECK(upgrade_with(h.port, "viz.example.org", "https://viz.example.org") == 0); /* --allow-origin */
     SL_CHECK(upgrade_with(h.port, "viz.example.org", "http://evil.example") != 0);
+    {   /* an Origin longer than the server's copy buffer is refused, not taken as absent */
+        char long_origin[400];
+        snprintf(long_origin, sizeof long_origin, "http://%0300d.example", 0);
+        snprintf(hostport, sizeof hostport, "127.0.0.1:%d", h.port);
+        SL_CHECK_MSG(upgrade_with(h.port, hostport, long_origin) != 0, "a %zu-byte Origin was accepted",
+                     strlen(long_origin));
+    }
 
     /* --- hello timeout (--hello-timeout 2 here): a silent connection is closed
      *     after 2 s (lws checks timeouts once a second), one that said hello is not --- */
