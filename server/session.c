@@ -279,8 +279,10 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     if (!s->controller)
         s->controller = c->id;
     c->hello_done = 1;
+    sl_ws_pending_leave(srv, c);
     /* Render errors from before the join are history, not news for this client. */
     pthread_mutex_lock(&srv->lock);
+    srv->client_count++;
     c->error_seq = s->error_seq;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
@@ -455,6 +457,18 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
     if (m->version != SL_PROTO_VERSION) {
         send_error(srv, c, "bad_version", "this server speaks protocol version 1", "version");
         c->close_after_send = 1;
+        return;
+    }
+    if (srv->client_count >= srv->cfg.max_clients) {
+        /* Pending connections are not counted at upgrade; the slot is taken here. */
+        char msg[120];
+        snprintf(msg, sizeof msg, "the server already has %d clients (--max-clients); retry later",
+                 srv->cfg.max_clients);
+        send_error(srv, c, "full", msg, "");
+        c->close_after_send = 1;
+        pthread_mutex_lock(&srv->lock);
+        srv->metrics.refused_full++;
+        pthread_mutex_unlock(&srv->lock);
         return;
     }
     sl_session *s;
