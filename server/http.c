@@ -102,6 +102,8 @@ char *sl_http_metrics(sl_server *srv)
         {"sightline_errors_sent_total", "error messages sent to clients.", m.errors_sent},
         {"sightline_dataset_loads_total", "Datasets loaded or generated (cache misses).", m.dataset_loads},
         {"sightline_dataset_cache_hits_total", "Sessions given an already loaded dataset.", m.dataset_cache_hits},
+        {"sightline_dataset_load_failures_total", "Dataset loads that failed (the session kept its last good scene).",
+         m.dataset_load_failures},
         {"sightline_refused_full_total", "WebSocket upgrades or hellos refused: --max-clients past hello.",
          m.refused_full},
         {"sightline_refused_address_total", "WebSocket upgrades refused: --max-pending-per-address.",

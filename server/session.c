@@ -745,6 +745,48 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
     c->session = NULL;
 }
 
+/* Dataset loads that failed (render.c): the session goes back to the last
+ * scene that rendered, unless its desired dataset changed since. The bounds
+ * follow as the render thread's description of the kept dataset. */
+static void apply_reverts(sl_server *srv)
+{
+    for (;;) {
+        sl_session *s = NULL;
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *t = srv->sessions; t && !s; t = t->next)
+            if (!t->doomed && t->revert_pending)
+                s = t;
+        int reverted = 0;
+        if (s) {
+            s->revert_pending = 0;
+            sl_session_state *st = &s->state;
+            const sl_session_state *to = &s->revert_to;
+            if (strcmp(st->dataset_source, s->revert_failed_source) == 0) {
+                memcpy(st->dataset, to->dataset, sizeof st->dataset);
+                memcpy(st->dataset_source, to->dataset_source, sizeof st->dataset_source);
+                st->dataset_is_file = to->dataset_is_file;
+                st->dataset_kind = to->dataset_kind;
+                memcpy(st->technique, to->technique, sizeof st->technique);
+                st->params = to->params;
+                st->phase = SL_PHASE_NONE;
+                state_changed_locked(srv, s);
+                reverted = 1;
+            }
+        }
+        pthread_mutex_unlock(&srv->lock);
+        if (!s)
+            return;
+        if (!reverted)
+            continue;
+        cJSON_Delete(s->bounds);
+        s->bounds = NULL;
+        cJSON *full = state_json(s);
+        cJSON_DeleteItemFromObjectCaseSensitive(full, "stream");
+        broadcast_patch(s, full);
+        persist(srv, s);
+    }
+}
+
 void sl_sessions_on_wake(sl_server *srv)
 {
     pthread_mutex_lock(&srv->lock);
@@ -776,6 +818,7 @@ void sl_sessions_on_wake(sl_server *srv)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
+    apply_reverts(srv);
     /* Dataset descriptions from the render thread: taken under the lock, written
      * to the catalog and broadcast outside it (SQLite must not stall rendering). */
     for (;;) {
@@ -881,7 +924,8 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     if (c->error_seq != s->error_seq) {
         c->error_seq = s->error_seq;
         srv->metrics.errors_sent++;
-        error = sl_msg_error_text("render_failed", s->error_text, "");
+        int load = strcmp(s->error_code, "load_failed") == 0;
+        error = sl_msg_error_text(load ? "load_failed" : "render_failed", s->error_text, load ? "dataset" : "");
     }
     pthread_mutex_unlock(&srv->lock);
     if (error)

@@ -183,8 +183,16 @@ struct sl_session {
     sl_frame_buf *snap_ready;                /* [lock] rendered PNG */
     int snap_ready_ids[SL_SESSION_MAX_SNAPSHOTS];
     int snap_ready_count;
-    char error_text[512];                    /* [lock] last render error */
+    char error_code[24];                     /* [lock] code of the last error: render_failed, load_failed */
+    char error_text[512];                    /* [lock] last render or load error */
     uint32_t error_seq;                      /* [lock] */
+    /* A dataset load failed: put the scene (dataset, technique, params) back
+     * to revert_to unless the desired state moved on from the failed source.
+     * Written by the render thread, applied by the service thread, which
+     * stays the only writer of `state`. */
+    int revert_pending;                      /* [lock] */
+    char revert_failed_source[SL_SOURCE_MAX];/* [lock] */
+    sl_session_state revert_to;              /* [lock] */
     int doomed;                              /* [lock] expired; render thread frees */
     char *info_bounds, *info_counts, *info_attrs; /* [lock] set by the render thread after a load */
     char info_dataset[SL_PROTO_NAME_MAX];    /* [lock] which dataset the info describes */
@@ -200,6 +208,8 @@ struct sl_session {
     /* [render] */
     sl_pipeline *pipeline;
     char loaded_source[SL_SOURCE_MAX];
+    sl_session_state good;                   /* the last state that rendered a frame */
+    int has_good;
     sl_iscale iscale;                        /* interactive scale estimates */
 };
 
@@ -215,7 +225,7 @@ typedef struct sl_histogram {
 typedef struct sl_metrics {                  /* [lock] */
     uint64_t frames_rendered, frames_sent, frames_dropped, frames_failed;
     uint64_t snapshots, bytes_sent, messages_in, errors_sent;
-    uint64_t dataset_loads, dataset_cache_hits;
+    uint64_t dataset_loads, dataset_cache_hits, dataset_load_failures;
     uint64_t refused_full, refused_address, pending_evicted;  /* WebSocket admission */
     sl_histogram render_ms, encode_ms;
 } sl_metrics;
