@@ -101,7 +101,9 @@ static int send_camera(tclient *c, uint32_t seq, const char *phase, double az)
 static int overhead_table(const char *dataset, int w, int h, double seconds)
 {
     harness hs;
-    const char *extra[] = {"--default-dataset", dataset, NULL};
+    /* Up to 15 viewers connect at once from 127.0.0.1 (default pending cap per address: 4). */
+    const char *extra[] = {"--default-dataset", dataset, "--max-pending", "32", "--max-pending-per-address", "32",
+                           NULL};
     if (harness_start(&hs, extra) != 0) {
         fprintf(stderr, "bench-server: could not start the server\n");
         harness_stop(&hs);

@@ -34,6 +34,7 @@ char *sl_http_healthz(sl_server *srv, int *status)
     cJSON_AddNumberToObject(o, "uptime_s", (sl_clock_ms() - srv->start_ms) / 1000.0);
     cJSON_AddNumberToObject(o, "sessions", srv->session_count);
     cJSON_AddNumberToObject(o, "clients", srv->client_count);
+    cJSON_AddNumberToObject(o, "pending", srv->pending_count);
     cJSON_AddStringToObject(o, "renderer", srv->gpu_renderer);
     cJSON_AddNumberToObject(o, "protocol", SL_PROTO_VERSION);
     pthread_mutex_unlock(&srv->lock);
@@ -87,7 +88,7 @@ char *sl_http_metrics(sl_server *srv)
     char *b = malloc(cap);
     pthread_mutex_lock(&srv->lock);
     sl_metrics m = srv->metrics;
-    int sessions = srv->session_count, clients = srv->client_count;
+    int sessions = srv->session_count, clients = srv->client_count, pending = srv->pending_count;
     pthread_mutex_unlock(&srv->lock);
     struct { const char *name, *help; uint64_t v; } counters[] = {
         {"sightline_frames_rendered_total", "Frames rendered and encoded.", m.frames_rendered},
@@ -101,12 +102,22 @@ char *sl_http_metrics(sl_server *srv)
         {"sightline_errors_sent_total", "error messages sent to clients.", m.errors_sent},
         {"sightline_dataset_loads_total", "Datasets loaded or generated (cache misses).", m.dataset_loads},
         {"sightline_dataset_cache_hits_total", "Sessions given an already loaded dataset.", m.dataset_cache_hits},
+        {"sightline_dataset_load_failures_total", "Dataset loads that failed (the session kept its last good scene).",
+         m.dataset_load_failures},
+        {"sightline_refused_full_total", "WebSocket upgrades or hellos refused: --max-clients past hello.",
+         m.refused_full},
+        {"sightline_refused_address_total", "WebSocket upgrades refused: --max-pending-per-address.",
+         m.refused_address},
+        {"sightline_pending_evicted_total", "Connections without hello closed to make room (--max-pending).",
+         m.pending_evicted},
     };
     for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
         append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,
                counters[i].name, counters[i].name, (unsigned long long)counters[i].v);
-    append(&b, &len, &cap, "# HELP sightline_clients Connected WebSocket clients.\n# TYPE sightline_clients gauge\n"
+    append(&b, &len, &cap, "# HELP sightline_clients WebSocket clients past hello.\n# TYPE sightline_clients gauge\n"
            "sightline_clients %d\n", clients);
+    append(&b, &len, &cap, "# HELP sightline_pending_connections WebSocket connections that have not sent hello.\n"
+           "# TYPE sightline_pending_connections gauge\nsightline_pending_connections %d\n", pending);
     append(&b, &len, &cap, "# HELP sightline_sessions Live sessions.\n# TYPE sightline_sessions gauge\n"
            "sightline_sessions %d\n", sessions);
     histogram(&b, &len, &cap, "sightline_render_ms", "Render plus readback wall time per frame, ms.", &m.render_ms);

@@ -2,6 +2,7 @@
  *
  *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH] [--data-dir DIR]...
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
+ *                    [--max-pending N] [--max-pending-per-address N]
  *                    [--max-sessions N] [--grace S] [--egl-device D]
  *                    [--default-dataset NAME] [--hello-timeout S]
  *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]   (tests only)
@@ -46,7 +47,8 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
-            "                        [--allow-origin URL]... [--max-clients N] [--max-sessions N] [--grace SECONDS]\n"
+            "                        [--allow-origin URL]... [--max-clients N] [--max-pending N]\n"
+            "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--egl-device software|INDEX] [--default-dataset NAME] [--hello-timeout S]\n"
             "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]\n"
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
@@ -159,8 +161,9 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
 
 int main(int argc, char **argv)
 {
-    sl_server_config cfg = {.port = 8080, .bind = "127.0.0.1", .max_clients = 64, .max_sessions = 32,
-                            .grace_s = 300, .hello_timeout_s = 10};
+    sl_server_config cfg = {.port = 8080, .bind = "127.0.0.1", .max_clients = 64, .max_pending = 16,
+                            .max_pending_per_address = 4, .max_sessions = 32, .grace_s = 300,
+                            .hello_timeout_s = 10};
     char db_default[PATH_MAX], web_default[PATH_MAX], data_default[PATH_MAX];
     const char *xdg = getenv("XDG_DATA_HOME"), *home = getenv("HOME");
     if (xdg && xdg[0])
@@ -200,6 +203,10 @@ int main(int argc, char **argv)
             i++;
         } else if (strcmp(a, "--max-clients") == 0 && v) {
             ok = parse_int(v, 1, 10000, &cfg.max_clients), i++;
+        } else if (strcmp(a, "--max-pending") == 0 && v) {
+            ok = parse_int(v, 1, 10000, &cfg.max_pending), i++;
+        } else if (strcmp(a, "--max-pending-per-address") == 0 && v) {
+            ok = parse_int(v, 1, 10000, &cfg.max_pending_per_address), i++;
         } else if (strcmp(a, "--max-sessions") == 0 && v) {
             ok = parse_int(v, 1, 10000, &cfg.max_sessions), i++;
         } else if (strcmp(a, "--grace") == 0 && v) {

@@ -14,7 +14,10 @@
  * session's measured frame costs, at the interactive JPEG quality; once the
  * delay passes a full-size still frame follows. Sessions are picked round
  * robin so one busy session cannot starve another. Sessions on the same
- * dataset share one loaded copy (dataset_cache.c). Never touches a socket.
+ * dataset share one loaded copy (dataset_cache.c). A dataset that fails to
+ * load leaves the pipeline on the last one that rendered; the session gets
+ * load_failed and the service thread puts its scene back (s->good ->
+ * revert_to). Never touches a socket.
  */
 #include "sl_server.h"
 
@@ -113,8 +116,112 @@ static uint64_t scene_key(const sl_session_state *st)
     return fnv1a(h, &st->height, sizeof st->height);
 }
 
-/* Loads the dataset when its source changed, selects the technique and
- * renders at scale (1 = the session's size) with interactive or still
+/* A dataset's description (sl_catalog_describe: bounds, counts, attribute
+ * names), made outside the lock and posted under it. */
+typedef struct info_texts {
+    char *bounds, *counts, *attrs;
+} info_texts;
+
+/* Hands the texts (consumed) to the service thread as the description of
+ * dataset `name` (catalog row, the session's bounds). Lock held. */
+static void post_info_locked(sl_session *s, info_texts *in, const char *name)
+{
+    free(s->info_bounds);
+    free(s->info_counts);
+    free(s->info_attrs);
+    s->info_bounds = in->bounds;
+    s->info_counts = in->counts;
+    s->info_attrs = in->attrs;
+    memset(in, 0, sizeof *in);
+    snprintf(s->info_dataset, sizeof s->info_dataset, "%s", name);
+    s->info_pending = 1;
+}
+
+/* Creates the session's pipeline and gives it the dataset of st when its
+ * source changed. On a load failure the pipeline keeps the dataset it had
+ * and err holds the loader's reason (SL_ERR_FORMAT, SL_ERR_IO, ...). */
+static sl_status ensure_dataset(render_ctx *ctx, sl_session *s, const sl_session_state *st, sl_err *err)
+{
+    sl_status rc;
+    if (!s->pipeline && (rc = sl_pipeline_create(ctx->gpu, &s->pipeline, err)) != SL_OK)
+        return rc;
+    if (strcmp(s->loaded_source, st->dataset_source) == 0 && sl_pipeline_dataset(s->pipeline))
+        return SL_OK;
+    sl_dataset *ds = NULL;
+    uint64_t loads = ctx->datasets.loads;
+    if ((rc = sl_dataset_cache_get(&ctx->datasets, st->dataset_source, st->dataset_is_file, &ds, err)) != SL_OK)
+        return rc;
+    info_texts info;
+    sl_catalog_describe(ds, &info.bounds, &info.counts, &info.attrs);
+    sl_pipeline_set_dataset(s->pipeline, ds);
+    snprintf(s->loaded_source, sizeof s->loaded_source, "%s", st->dataset_source);
+    pthread_mutex_lock(&ctx->srv->lock);
+    if (ctx->datasets.loads != loads)
+        ctx->srv->metrics.dataset_loads++;
+    else
+        ctx->srv->metrics.dataset_cache_hits++;
+    post_info_locked(s, &info, st->dataset);
+    pthread_mutex_unlock(&ctx->srv->lock);
+    return SL_OK;
+}
+
+/* msg with every "<directory of path>/" removed, so a loader's message
+ * names the file but never shows clients where the server keeps it. */
+static void strip_dir(const char *msg, const char *path, char *out, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n = slash ? (size_t)(slash - path) + 1 : 0, o = 0;
+    for (const char *p = msg; *p && o + 1 < size;) {
+        if (n > 1 && strncmp(p, path, n) == 0) {
+            p += n;
+            continue;
+        }
+        out[o++] = *p++;
+    }
+    out[o] = '\0';
+}
+
+/* A dataset load for st failed: the session's clients get `load_failed`
+ * naming the dataset and the loader's reason, and the service thread is
+ * asked to put the session back on the last scene that rendered (s->good)
+ * if the desired state still names the failed source. The pipeline still
+ * holds that scene's dataset, so the next frame renders it without a load. */
+static void report_load_failure(render_ctx *ctx, sl_session *s, const sl_session_state *st, const sl_err *err)
+{
+    sl_server *srv = ctx->srv;
+    char reason[400];
+    strip_dir(err->message, st->dataset_source, reason, sizeof reason);
+    int revert = s->has_good && strcmp(s->good.dataset_source, st->dataset_source) != 0;
+    const sl_dataset *kept = revert && strcmp(s->loaded_source, s->good.dataset_source) == 0
+                                 ? sl_pipeline_dataset(s->pipeline) : NULL;
+    info_texts info = {0};
+    if (kept)
+        sl_catalog_describe(kept, &info.bounds, &info.counts, &info.attrs);
+    pthread_mutex_lock(&srv->lock);
+    snprintf(s->error_code, sizeof s->error_code, "load_failed");
+    if (revert)
+        snprintf(s->error_text, sizeof s->error_text, "dataset \"%.60s\" could not be loaded: %.360s; the session "
+                 "keeps showing \"%.60s\"", st->dataset, reason, s->good.dataset);
+    else
+        snprintf(s->error_text, sizeof s->error_text, "dataset \"%.60s\" could not be loaded: %.400s", st->dataset,
+                 reason);
+    s->error_seq++;
+    s->rendered_version = st->version;
+    s->rendered_interactive = 0;
+    srv->metrics.frames_failed++;
+    srv->metrics.dataset_load_failures++;
+    if (revert) {
+        s->revert_to = s->good;
+        snprintf(s->revert_failed_source, sizeof s->revert_failed_source, "%s", st->dataset_source);
+        s->revert_pending = 1;
+        if (kept)
+            post_info_locked(s, &info, s->good.dataset);
+    }
+    pthread_mutex_unlock(&srv->lock);
+}
+
+/* Selects the technique and renders the session's dataset (ensure_dataset
+ * first) at scale (1 = the session's size) with interactive or still
  * quality. *render_ms is the time of the render call, *prepare_ms the part
  * of it a technique prepare took. */
 static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
@@ -122,37 +229,6 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
                               sl_err *err)
 {
     sl_status rc;
-    if (!s->pipeline && (rc = sl_pipeline_create(ctx->gpu, &s->pipeline, err)) != SL_OK)
-        return rc;
-    if (strcmp(s->loaded_source, st->dataset_source) != 0 || !sl_pipeline_dataset(s->pipeline)) {
-        sl_dataset *ds = NULL;
-        uint64_t loads = ctx->datasets.loads;
-        rc = sl_dataset_cache_get(&ctx->datasets, st->dataset_source, st->dataset_is_file, &ds, err);
-        if (rc) {
-            sl_err_prefix(err, "dataset \"%s\"", st->dataset);
-            return rc;
-        }
-        pthread_mutex_lock(&ctx->srv->lock);
-        if (ctx->datasets.loads != loads)
-            ctx->srv->metrics.dataset_loads++;
-        else
-            ctx->srv->metrics.dataset_cache_hits++;
-        pthread_mutex_unlock(&ctx->srv->lock);
-        char *b = NULL, *c = NULL, *a = NULL;
-        sl_catalog_describe(ds, &b, &c, &a);
-        sl_pipeline_set_dataset(s->pipeline, ds);
-        snprintf(s->loaded_source, sizeof s->loaded_source, "%s", st->dataset_source);
-        pthread_mutex_lock(&ctx->srv->lock);
-        free(s->info_bounds);
-        free(s->info_counts);
-        free(s->info_attrs);
-        s->info_bounds = b;
-        s->info_counts = c;
-        s->info_attrs = a;
-        snprintf(s->info_dataset, sizeof s->info_dataset, "%s", st->dataset);
-        s->info_pending = 1;
-        pthread_mutex_unlock(&ctx->srv->lock);
-    }
     const sl_dataset *ds = sl_pipeline_dataset(s->pipeline);
     const sl_technique *t = sl_technique_find(st->technique);
     if (!t)
@@ -193,6 +269,7 @@ static sl_status render_state(render_ctx *ctx, sl_session *s, const sl_session_s
 static void report_error(sl_server *srv, sl_session *s, const sl_session_state *st, const sl_err *err)
 {
     pthread_mutex_lock(&srv->lock);
+    snprintf(s->error_code, sizeof s->error_code, "render_failed");
     snprintf(s->error_text, sizeof s->error_text, "%.500s", err->message);
     s->error_seq++;
     s->rendered_version = st->version;
@@ -223,6 +300,13 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     sl_frame_buf *f = NULL;
     sl_iscale_sync(&s->iscale, scene_key(st), st->stream.interactive_scale);
     double scale = interactive ? sl_iscale_choose(&s->iscale, &st->stream, &step) : 1.0;
+    if (ensure_dataset(ctx, s, st, &err) != SL_OK) {
+        if (s->pipeline)
+            report_load_failure(ctx, s, st, &err);
+        else
+            report_error(ctx->srv, s, st, &err);
+        return;
+    }
     if (render_state(ctx, s, st, interactive, scale, &w, &h, &render_ms, &prepare_ms, &err) != SL_OK) {
         report_error(ctx->srv, s, st, &err);
         return;
@@ -240,6 +324,8 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
         return;
     }
     sl_iscale_record(&s->iscale, interactive, step, cost_ms + encode_ms);
+    s->good = *st;
+    s->has_good = 1;
     sl_server *srv = ctx->srv;
     pthread_mutex_lock(&srv->lock);
     f->header.frame_id = ++s->next_frame_id;
@@ -265,6 +351,13 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
     double render_ms = 0, prepare_ms = 0, encode_ms = 0;
     sl_frame_buf *f = NULL;
     sl_server *srv = ctx->srv;
+    if (ensure_dataset(ctx, s, st, &err) != SL_OK) {
+        if (s->pipeline)
+            report_load_failure(ctx, s, st, &err);
+        else
+            report_error(srv, s, st, &err);
+        return;
+    }
     if (render_state(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &prepare_ms, &err) == SL_OK) {
         sl_pipeline_read_rgba(s->pipeline, ctx->rgba, 1);
         if (sl_encoder_png(ctx->rgba, w, h, &f, &encode_ms, &err) == SL_OK) {
@@ -281,6 +374,7 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
         s->snap_ready_count = n;
         srv->metrics.snapshots++;
     } else {
+        snprintf(s->error_code, sizeof s->error_code, "render_failed");
         snprintf(s->error_text, sizeof s->error_text, "snapshot failed: %.480s", err.message);
         s->error_seq++;
     }

@@ -277,8 +277,10 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     if (!s->controller)
         s->controller = c->id;
     c->hello_done = 1;
+    sl_ws_pending_leave(srv, c);
     /* Render errors from before the join are history, not news for this client. */
     pthread_mutex_lock(&srv->lock);
+    srv->client_count++;
     c->error_seq = s->error_seq;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
@@ -445,6 +447,18 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
     if (m->version != SL_PROTO_VERSION) {
         send_error(srv, c, "bad_version", "this server speaks protocol version 1", "version");
         c->close_after_send = 1;
+        return;
+    }
+    if (srv->client_count >= srv->cfg.max_clients) {
+        /* Pending connections are not counted at upgrade; the slot is taken here. */
+        char msg[120];
+        snprintf(msg, sizeof msg, "the server already has %d clients (--max-clients); retry later",
+                 srv->cfg.max_clients);
+        send_error(srv, c, "full", msg, "");
+        c->close_after_send = 1;
+        pthread_mutex_lock(&srv->lock);
+        srv->metrics.refused_full++;
+        pthread_mutex_unlock(&srv->lock);
         return;
     }
     sl_session *s;
@@ -724,6 +738,48 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
     c->session = NULL;
 }
 
+/* Dataset loads that failed (render.c): the session goes back to the last
+ * scene that rendered, unless its desired dataset changed since. The bounds
+ * follow as the render thread's description of the kept dataset. */
+static void apply_reverts(sl_server *srv)
+{
+    for (;;) {
+        sl_session *s = NULL;
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *t = srv->sessions; t && !s; t = t->next)
+            if (!t->doomed && t->revert_pending)
+                s = t;
+        int reverted = 0;
+        if (s) {
+            s->revert_pending = 0;
+            sl_session_state *st = &s->state;
+            const sl_session_state *to = &s->revert_to;
+            if (strcmp(st->dataset_source, s->revert_failed_source) == 0) {
+                memcpy(st->dataset, to->dataset, sizeof st->dataset);
+                memcpy(st->dataset_source, to->dataset_source, sizeof st->dataset_source);
+                st->dataset_is_file = to->dataset_is_file;
+                st->dataset_kind = to->dataset_kind;
+                memcpy(st->technique, to->technique, sizeof st->technique);
+                st->params = to->params;
+                st->phase = SL_PHASE_NONE;
+                state_changed_locked(srv, s);
+                reverted = 1;
+            }
+        }
+        pthread_mutex_unlock(&srv->lock);
+        if (!s)
+            return;
+        if (!reverted)
+            continue;
+        cJSON_Delete(s->bounds);
+        s->bounds = NULL;
+        cJSON *full = state_json(s);
+        cJSON_DeleteItemFromObjectCaseSensitive(full, "stream");
+        broadcast_patch(s, full);
+        persist(srv, s);
+    }
+}
+
 void sl_sessions_on_wake(sl_server *srv)
 {
     pthread_mutex_lock(&srv->lock);
@@ -755,6 +811,7 @@ void sl_sessions_on_wake(sl_server *srv)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
+    apply_reverts(srv);
     /* Dataset descriptions from the render thread: taken under the lock, written
      * to the catalog and broadcast outside it (SQLite must not stall rendering). */
     for (;;) {
@@ -860,7 +917,8 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     if (c->error_seq != s->error_seq) {
         c->error_seq = s->error_seq;
         srv->metrics.errors_sent++;
-        error = sl_msg_error_text("render_failed", s->error_text, "");
+        int load = strcmp(s->error_code, "load_failed") == 0;
+        error = sl_msg_error_text(load ? "load_failed" : "render_failed", s->error_text, load ? "dataset" : "");
     }
     pthread_mutex_unlock(&srv->lock);
     if (error)

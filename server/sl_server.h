@@ -63,7 +63,9 @@ typedef struct sl_server_config {
     int data_dir_count;
     const char *origins[SL_SERVER_MAX_ORIGINS];  /* extra allowed Origin values */
     int origin_count;
-    int max_clients;               /* default 64 */
+    int max_clients;               /* default 64: clients past hello */
+    int max_pending;               /* default 16: upgraded connections that have not sent hello */
+    int max_pending_per_address;   /* default 4: of those, from one peer address */
     int max_sessions;              /* default 32 */
     int grace_s;                   /* default 300 */
     int hello_timeout_s;           /* default 10: seconds from upgrade to hello */
@@ -147,8 +149,11 @@ typedef struct sl_session sl_session;
 struct sl_client {                  /* [service] */
     struct lws *wsi;
     int id;
+    char addr[64];                  /* peer address, numeric */
     sl_session *session;            /* NULL before hello */
     int hello_done;
+    int pending;                    /* in server->pending: upgraded, no hello yet */
+    sl_client *pending_next;        /* in server->pending (newest first) */
     char *rx;                       /* message being reassembled */
     size_t rx_len, rx_cap;
     uint8_t *text[SL_CLIENT_MAX_TEXT]; /* ring of LWS_PRE-prefixed texts */
@@ -179,8 +184,16 @@ struct sl_session {
     sl_frame_buf *snap_ready;                /* [lock] rendered PNG */
     int snap_ready_ids[SL_SESSION_MAX_SNAPSHOTS];
     int snap_ready_count;
-    char error_text[512];                    /* [lock] last render error */
+    char error_code[24];                     /* [lock] code of the last error: render_failed, load_failed */
+    char error_text[512];                    /* [lock] last render or load error */
     uint32_t error_seq;                      /* [lock] */
+    /* A dataset load failed: put the scene (dataset, technique, params) back
+     * to revert_to unless the desired state moved on from the failed source.
+     * Written by the render thread, applied by the service thread, which
+     * stays the only writer of `state`. */
+    int revert_pending;                      /* [lock] */
+    char revert_failed_source[SL_SOURCE_MAX];/* [lock] */
+    sl_session_state revert_to;              /* [lock] */
     int doomed;                              /* [lock] expired; render thread frees */
     char *info_bounds, *info_counts, *info_attrs; /* [lock] set by the render thread after a load */
     char info_dataset[SL_PROTO_NAME_MAX];    /* [lock] which dataset the info describes */
@@ -196,6 +209,8 @@ struct sl_session {
     /* [render] */
     sl_pipeline *pipeline;
     char loaded_source[SL_SOURCE_MAX];
+    sl_session_state good;                   /* the last state that rendered a frame */
+    int has_good;
     sl_iscale iscale;                        /* interactive scale estimates */
 };
 
@@ -211,7 +226,8 @@ typedef struct sl_histogram {
 typedef struct sl_metrics {                  /* [lock] */
     uint64_t frames_rendered, frames_sent, frames_dropped, frames_failed;
     uint64_t snapshots, bytes_sent, messages_in, errors_sent;
-    uint64_t dataset_loads, dataset_cache_hits;
+    uint64_t dataset_loads, dataset_cache_hits, dataset_load_failures;
+    uint64_t refused_full, refused_address, pending_evicted;  /* WebSocket admission */
     sl_histogram render_ms, encode_ms;
 } sl_metrics;
 
@@ -228,7 +244,9 @@ typedef struct sl_server {
     pthread_cond_t wake;                     /* render thread waits here */
     sl_session *sessions;                    /* [lock] */
     int session_count;                       /* [lock] live (not doomed) */
-    int client_count;                        /* [service] */
+    int client_count;                        /* [service] past hello: counted against --max-clients */
+    int pending_count;                       /* [service] upgraded, no hello yet: --max-pending */
+    sl_client *pending;                      /* [service] those connections, newest first */
     int next_client_id;                      /* [service] */
     sl_metrics metrics;                      /* [lock] */
     int stop;                                /* [lock] */
@@ -324,6 +342,8 @@ char *sl_http_metrics(sl_server *srv);
 
 /* ws.c */
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
+/* c no longer waits for hello (it said hello or closes); no-op when not pending. */
+void sl_ws_pending_leave(sl_server *srv, sl_client *c);
 void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted);
 void sl_ws_destroy(sl_server *srv);
 

@@ -11,6 +11,15 @@
  * (non-browser clients), equal to the served origin http://<Host> (Host
  * checked as above) or in the allow-list. The rules themselves are pure functions
  * (http_host.c); this file reads the headers.
+ * Admission: --max-clients counts only clients past hello. A connection
+ * between upgrade and hello is "pending": pending connections have their own
+ * budget (--max-pending) and a cap per peer address
+ * (--max-pending-per-address; an upgrade over it is refused), so connections
+ * that never say hello cannot lock real users out. When the budget is full a
+ * new upgrade evicts the oldest pending connection (which has had the
+ * longest to send hello), so a flood from many addresses delays nobody who
+ * says hello promptly. hello itself is refused with `full` when
+ * --max-clients clients are past it (session.c).
  * Incoming messages are reassembled up to SL_PROTO_MAX_HELLO bytes before
  * hello and SL_PROTO_MAX_MESSAGE after; a larger one closes only that
  * connection with 1008 (policy violation). Writes happen only in
@@ -99,6 +108,76 @@ static int filter_http(sl_server *srv, struct lws *wsi)
     return 1;
 }
 
+static void peer_address(struct lws *wsi, char *out, size_t size)
+{
+    if (!lws_get_peer_simple(wsi, out, size))
+        snprintf(out, size, "?");
+}
+
+static int pending_from(const sl_server *srv, const char *addr)
+{
+    int n = 0;
+    for (const sl_client *c = srv->pending; c; c = c->pending_next)
+        n += strcmp(c->addr, addr) == 0;
+    return n;
+}
+
+void sl_ws_pending_leave(sl_server *srv, sl_client *c)
+{
+    if (!c->pending)
+        return;
+    for (sl_client **pp = &srv->pending; *pp; pp = &(*pp)->pending_next)
+        if (*pp == c) {
+            *pp = c->pending_next;
+            break;
+        }
+    c->pending = 0;
+    c->pending_next = NULL;
+    pthread_mutex_lock(&srv->lock);
+    srv->pending_count--;
+    pthread_mutex_unlock(&srv->lock);
+}
+
+/* The budget is full: the oldest pending connection (the list's tail) is
+ * closed at the next service pass and ignored until then. */
+static void evict_oldest_pending(sl_server *srv)
+{
+    sl_client *oldest = srv->pending;
+    while (oldest && oldest->pending_next)
+        oldest = oldest->pending_next;
+    if (!oldest)
+        return;
+    lwsl_notice("evicted a pending WebSocket from %s (--max-pending %d)\n", oldest->addr, srv->cfg.max_pending);
+    sl_ws_pending_leave(srv, oldest);
+    oldest->close_after_send = 1;
+    lws_set_timeout(oldest->wsi, PENDING_TIMEOUT_USER_REASON_BASE + 2, LWS_TO_KILL_ASYNC);
+    pthread_mutex_lock(&srv->lock);
+    srv->metrics.pending_evicted++;
+    pthread_mutex_unlock(&srv->lock);
+}
+
+/* 1 when an upgrade from addr is refused: --max-clients past hello, or
+ * --max-pending-per-address pending from addr already. */
+static int admission_refused(sl_server *srv, const char *addr)
+{
+    int full = srv->client_count >= srv->cfg.max_clients;
+    int crowded = !full && pending_from(srv, addr) >= srv->cfg.max_pending_per_address;
+    if (!full && !crowded)
+        return 0;
+    if (full)
+        lwsl_notice("refused WebSocket: %d clients (--max-clients)\n", srv->client_count);
+    else
+        lwsl_notice("refused WebSocket: %d pending from %s (--max-pending-per-address)\n",
+                    srv->cfg.max_pending_per_address, addr);
+    pthread_mutex_lock(&srv->lock);
+    if (full)
+        srv->metrics.refused_full++;
+    else
+        srv->metrics.refused_address++;
+    pthread_mutex_unlock(&srv->lock);
+    return 1;
+}
+
 static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
     ws_pss *pss = user;
@@ -110,34 +189,48 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
             return 1;
         if (!origin_allowed(srv, wsi))
             return 1;
-        if (srv->client_count >= srv->cfg.max_clients) {
-            lwsl_notice("refused WebSocket: %d clients (--max-clients)\n", srv->client_count);
-            return 1;
-        }
-        return 0;
+        char addr[64];
+        peer_address(wsi, addr, sizeof addr);
+        return admission_refused(srv, addr);
     }
     case LWS_CALLBACK_ESTABLISHED: {
         sl_client *c = calloc(1, sizeof *c);
         if (!c)
             return -1;
+        peer_address(wsi, c->addr, sizeof c->addr);
+        /* Checked again: another upgrade may have been established since the filter. */
+        if (admission_refused(srv, c->addr)) {
+            free(c);
+            return -1;
+        }
+        if (srv->pending_count >= srv->cfg.max_pending)
+            evict_oldest_pending(srv);
         c->wsi = wsi;
         c->id = ++srv->next_client_id;
+        c->pending = 1;
+        c->pending_next = srv->pending;
+        srv->pending = c;
         pss->client = c;
         /* hello must come within --hello-timeout s (cleared in session.c when it does). */
         lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, srv->cfg.hello_timeout_s);
         pthread_mutex_lock(&srv->lock);
-        srv->client_count++;
+        srv->pending_count++;
         pthread_mutex_unlock(&srv->lock);
         return 0;
     }
     case LWS_CALLBACK_CLOSED:
         if (pss->client) {
-            sl_sessions_on_close(srv, pss->client);
-            free(pss->client);
+            sl_client *c = pss->client;
+            int counted = c->hello_done;
+            sl_ws_pending_leave(srv, c);
+            sl_sessions_on_close(srv, c);
+            free(c);
             pss->client = NULL;
-            pthread_mutex_lock(&srv->lock);
-            srv->client_count--;
-            pthread_mutex_unlock(&srv->lock);
+            if (counted) {
+                pthread_mutex_lock(&srv->lock);
+                srv->client_count--;
+                pthread_mutex_unlock(&srv->lock);
+            }
         }
         return 0;
     case LWS_CALLBACK_RECEIVE: {

@@ -10,7 +10,8 @@
  * (1008); a wrong token is refused; two clients of one session see each
  * other's changes and the same frame ids; viewers are refused until granted
  * control; the ack window holds; snapshots are PNGs; views save and load;
- * scene switches; the Origin check; /healthz and /metrics; and a session
+ * scene switches (a vanished file gives load_failed without the server's
+ * path); the Origin check; /healthz and /metrics; and a session
  * outlives its clients for the grace period, then expires. The server must
  * exit cleanly (status 0, so no ASan leak report) at the end.
  */
@@ -820,17 +821,21 @@ int main(void)
             SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"%s\"}", current) == 0);
         }
 
-        /* The file vanishes; switching away (rendered) and back makes the render thread reload and fail. */
+        /* The file vanishes; switching away (rendered) and back makes the render thread reload and fail:
+         * load_failed reaches every client of the session, without the server's path. */
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
         uint32_t vt = wait_patch(&a, "dataset", "tiny");
         SL_CHECK(vt > 0 && wait_version(&a, vt) == 0);
         SL_CHECK(unlink(objpath) == 0);
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
         e = tclient_wait_type(&a, "error", T);
-        SL_CHECK(error_is(e, "render_failed", NULL));
+        SL_CHECK(error_is(e, "load_failed", "dataset"));
+        const cJSON *em = cJSON_GetObjectItemCaseSensitive(e, "message");
+        SL_CHECK_MSG(cJSON_IsString(em) && strstr(em->valuestring, "lines.obj") && !strstr(em->valuestring, h.dir),
+                     "load_failed message %s", cJSON_IsString(em) ? em->valuestring : "(none)");
         cJSON_Delete(e);
         e = tclient_wait_type(&b, "error", T);
-        SL_CHECK(error_is(e, "render_failed", NULL));
+        SL_CHECK(error_is(e, "load_failed", "dataset"));
         cJSON_Delete(e);
         SL_CHECK(still_usable(&a, 5));
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
