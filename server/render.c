@@ -200,7 +200,7 @@ static void report_load_failure(render_ctx *ctx, sl_session *s, const sl_session
     pthread_mutex_lock(&srv->lock);
     snprintf(s->error_code, sizeof s->error_code, "load_failed");
     if (revert)
-        snprintf(s->error_text, sizeof s->error_text, "dataset \"%.60s\" could not be loaded: %.360s; the session "
+        snprintf(s->error_text, sizeof s->error_text, "dataset \"%.60s\" could not be loaded: %.320s; the session "
                  "keeps showing \"%.60s\"", st->dataset, reason, s->good.dataset);
     else
         snprintf(s->error_text, sizeof s->error_text, "dataset \"%.60s\" could not be loaded: %.400s", st->dataset,
