@@ -17,6 +17,7 @@
 #include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -32,6 +33,7 @@
 #include <cjson/cJSON.h>
 
 #include "core/sl_clock.h"
+#include "image/sl_image.h"
 #include "sl_protocol.h"
 #include "sl_wsclient.h"
 
@@ -381,6 +383,41 @@ static __attribute__((unused)) int tclient_wait_frame(tclient *c, uint32_t seq, 
             return -1;
     }
     return -1;
+}
+
+/* Waits for a frame whose state version is at least `version`; 0, or -1 on timeout or close. */
+static __attribute__((unused)) int tclient_wait_version(tclient *c, uint32_t version, int timeout_ms)
+{
+    double deadline = sl_clock_ms() + timeout_ms;
+    while (sl_clock_ms() < deadline) {
+        if (tclient_wait_frame(c, 0, 1, timeout_ms) != 0)
+            return -1;
+        if (c->last.h.state_version >= version)
+            return 0;
+    }
+    return -1;
+}
+
+/* The last JPEG frame decoded (rgba NULL when it does not decode; free with sl_image_free). */
+static __attribute__((unused)) sl_image tclient_decode_last(tclient *c)
+{
+    sl_image img = {0};
+    sl_err err;
+    if (sl_jpeg_decode(c->last.payload, c->last.h.payload_bytes, &img, &err) != SL_OK)
+        fprintf(stderr, "decode failed: %s\n", err.message);
+    return img;
+}
+
+/* Mean absolute difference per channel of two same-size images; -1 on size mismatch. */
+static __attribute__((unused)) double harness_mean_diff(const sl_image *a, const sl_image *b)
+{
+    if (!a->rgba || !b->rgba || a->width != b->width || a->height != b->height)
+        return -1;
+    double sum = 0;
+    size_t n = (size_t)a->width * (size_t)a->height * 4;
+    for (size_t i = 0; i < n; i++)
+        sum += fabs((double)a->rgba[i] - (double)b->rgba[i]);
+    return sum / (double)n;
 }
 
 /* GET path from 127.0.0.1:port with the given Host header (NULL:

@@ -25,26 +25,6 @@
 #define GOOD_OBJ "v 0 0 0\nv 1 2 3\nv 0.5 1 0\nv 1 0 3\nl 1 2\nl 3 4\n"
 #define TRUNCATED_OBJ "v 0 0 0\nv 1 2 3\nv 0.5 1 0\nv 1 0"
 
-static sl_image decode_last(tclient *c)
-{
-    sl_image img = {0};
-    sl_err err;
-    if (sl_jpeg_decode(c->last.payload, c->last.h.payload_bytes, &img, &err) != SL_OK)
-        fprintf(stderr, "decode failed: %s\n", err.message);
-    return img;
-}
-
-static double mean_diff(const sl_image *a, const sl_image *b)
-{
-    if (!a->rgba || !b->rgba || a->width != b->width || a->height != b->height)
-        return -1;
-    double sum = 0;
-    size_t n = (size_t)a->width * (size_t)a->height * 4;
-    for (size_t i = 0; i < n; i++)
-        sum += fabs((double)a->rgba[i] - (double)b->rgba[i]);
-    return sum / (double)n;
-}
-
 static int write_file(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -129,7 +109,7 @@ int main(void)
     a.auto_ack = 1;
     int a_errors = 0, b_errors = 0;
     SL_CHECK(wait_still_version(&a, 1, &a_errors) == 0);
-    sl_image before = decode_last(&a);
+    sl_image before = tclient_decode_last(&a);
     const char *technique = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "state"),
                                                              "technique")->valuestring;
 
@@ -193,8 +173,8 @@ int main(void)
 
     /* A still renders its previous dataset: the same image at the same camera. */
     SL_CHECK(wait_still_version(&a, v_revert, &a_errors) == 0);
-    sl_image after = decode_last(&a);
-    double d = mean_diff(&before, &after);
+    sl_image after = tclient_decode_last(&a);
+    double d = harness_mean_diff(&before, &after);
     SL_CHECK_MSG(d >= 0 && d < 1.0, "A's frame after the failed load differs from before: mean abs %.3f", d);
     SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":3,\"camera\":{\"orbit\":{\"azimuth\":100,\"elevation\":10,"
                               "\"distance\":2.5}}}") == 0);

@@ -53,19 +53,6 @@ static int still_at(tclient *c, uint32_t seq, double azimuth)
     return tclient_wait_frame(c, seq, 1, T);
 }
 
-/* Waits for a still frame showing state version >= version. */
-static int wait_version(tclient *c, uint32_t version)
-{
-    double deadline = sl_clock_ms() + T;
-    while (sl_clock_ms() < deadline) {
-        if (tclient_wait_frame(c, 0, 1, T) != 0)
-            return -1;
-        if (c->last.h.state_version >= version)
-            return 0;
-    }
-    return -1;
-}
-
 /* Waits for a state patch with key; returns its version, 0 on timeout; *patch_out (optional) the patch copy. */
 static uint32_t wait_patch_key(tclient *c, const char *key, cJSON **patch_out)
 {
@@ -173,7 +160,7 @@ static void resize_and_quality(const harness *h)
              cJSON_GetObjectItemCaseSensitive(patch, "height") &&
              cJSON_GetObjectItemCaseSensitive(patch, "height")->valueint == 60);
     cJSON_Delete(patch);
-    SL_CHECK(wait_version(&ctl, v) == 0 && wait_version(&view, v) == 0);
+    SL_CHECK(tclient_wait_version(&ctl, v, T) == 0 && tclient_wait_version(&view, v, T) == 0);
     SL_CHECK_MSG(ctl.last.h.width == 80 && ctl.last.h.height == 60 && view.last.h.width == 80 &&
                  view.last.h.height == 60, "frames after resize: %ux%u and %ux%u", ctl.last.h.width,
                  ctl.last.h.height, view.last.h.width, view.last.h.height);

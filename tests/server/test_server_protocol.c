@@ -28,27 +28,6 @@
 #define H 96
 #define T 20000   /* generous per-step timeout (ASan + llvmpipe on 2 busy cores) */
 
-static sl_image decode_last(tclient *c)
-{
-    sl_image img = {0};
-    sl_err err;
-    if (sl_jpeg_decode(c->last.payload, c->last.h.payload_bytes, &img, &err) != SL_OK)
-        fprintf(stderr, "decode failed: %s\n", err.message);
-    return img;
-}
-
-/* Mean absolute difference per channel of two same-size images; -1 on size mismatch. */
-static double mean_diff(const sl_image *a, const sl_image *b)
-{
-    if (!a->rgba || !b->rgba || a->width != b->width || a->height != b->height)
-        return -1;
-    double sum = 0;
-    size_t n = (size_t)a->width * (size_t)a->height * 4;
-    for (size_t i = 0; i < n; i++)
-        sum += fabs((double)a->rgba[i] - (double)b->rgba[i]);
-    return sum / (double)n;
-}
-
 /* Fraction of pixels that differ from the top-left (background) pixel by more than 24 in any channel. */
 static double foreground_fraction(const sl_image *img)
 {
@@ -111,19 +90,6 @@ static uint32_t wait_patch(tclient *c, const char *key, const char *value)
             return version;
     }
     return 0;
-}
-
-/* Waits for a still frame that shows state version >= version. */
-static int wait_version(tclient *c, uint32_t version)
-{
-    double deadline = sl_clock_ms() + T;
-    while (sl_clock_ms() < deadline) {
-        if (tclient_wait_frame(c, 0, 1, T) != 0)
-            return -1;
-        if (c->last.h.state_version >= version)
-            return 0;
-    }
-    return -1;
 }
 
 /* Waits for a state patch carrying `key`; returns the message (caller frees) or NULL. */
@@ -290,7 +256,7 @@ int main(void)
     SL_CHECK(a.last.h.width == W && a.last.h.height == H);
     SL_CHECK(a.last.h.quality == 92 && a.last.h.subsampling == 0);
     SL_CHECK(a.last.h.state_version >= 1 && a.last.h.frame_id >= 1);
-    sl_image first = decode_last(&a);
+    sl_image first = tclient_decode_last(&a);
     SL_CHECK(first.width == W && first.height == H);
     double fg = foreground_fraction(&first);
     SL_CHECK_MSG(fg > 0.01 && fg < 0.95, "foreground fraction %.3f", fg);
@@ -299,8 +265,8 @@ int main(void)
     SL_CHECK(tclient_send(&a, "{\"type\":\"camera\",\"seq\":5,\"camera\":{\"orbit\":{\"azimuth\":120,\"elevation\":-30,\"distance\":2}}}") == 0);
     SL_CHECK(tclient_wait_frame(&a, 5, 1, T) == 0);
     SL_CHECK(a.last.h.camera_seq == 5);
-    sl_image second = decode_last(&a);
-    double d = mean_diff(&first, &second);
+    sl_image second = tclient_decode_last(&a);
+    double d = harness_mean_diff(&first, &second);
     SL_CHECK_MSG(d > 1.0, "mean abs difference after a camera change %.3f", d);
 
     /* --- dragging at a fixed scale (adaptive off, interactive_scale 0.5): half-size
@@ -325,7 +291,7 @@ int main(void)
     if (saw_interactive) {
         SL_CHECK(a.last.h.width == W / 2 && a.last.h.height == H / 2);
         SL_CHECK(a.last.h.quality == 60 && a.last.h.subsampling == 1);
-        sl_image half = decode_last(&a);
+        sl_image half = tclient_decode_last(&a);
         SL_CHECK(half.width == W / 2);
         sl_image_deinit(&half);
     }
@@ -418,7 +384,7 @@ int main(void)
     SL_CHECK(pp && fabs(cJSON_GetObjectItemCaseSensitive(pp, pname)->valuedouble - newv) < 1e-9);
     uint32_t set_version = st ? (uint32_t)cJSON_GetObjectItemCaseSensitive(st, "version")->valuedouble : 0;
     cJSON_Delete(st);
-    SL_CHECK(set_version > 0 && wait_version(&a, set_version) == 0 && a.max_frame_id > before);
+    SL_CHECK(set_version > 0 && tclient_wait_version(&a, set_version, T) == 0 && a.max_frame_id > before);
 
     /* --- oversize messages close only that connection --- */
     tclient big;
@@ -631,7 +597,7 @@ int main(void)
      *     bottom-up readback through TurboJPEG's bottom-up flag, PNG from a top-down read) --- */
     SL_CHECK(a.last.h.kind == SL_FRAME_JPEG && a.last.h.camera_seq == 25 &&
              !(a.last.h.flags & SL_FRAME_FLAG_INTERACTIVE));
-    sl_image still_jpeg = decode_last(&a);
+    sl_image still_jpeg = tclient_decode_last(&a);
     SL_CHECK(tclient_send(&a, "{\"type\":\"snapshot\"}") == 0);
     int got_png = 0;
     double sdl = sl_clock_ms() + T;
@@ -651,7 +617,7 @@ int main(void)
         sl_err err;
         SL_CHECK(sl_png_read(path, &png, &err) == SL_OK && png.width == W && png.height == H);
         SL_CHECK(foreground_fraction(&png) > 0.01);
-        double dj = mean_diff(&png, &still_jpeg);
+        double dj = harness_mean_diff(&png, &still_jpeg);
         SL_CHECK_MSG(dj >= 0 && dj < 4.0, "PNG snapshot vs still JPEG mean abs difference %.3f (bound 4)", dj);
         /* The same comparison against the JPEG flipped upside down must be clearly worse. */
         sl_image flipped = {.width = still_jpeg.width, .height = still_jpeg.height,
@@ -660,7 +626,7 @@ int main(void)
             size_t row = (size_t)still_jpeg.width * 4;
             for (int y = 0; y < still_jpeg.height; y++)
                 memcpy(flipped.rgba + row * (size_t)y, still_jpeg.rgba + row * (size_t)(still_jpeg.height - 1 - y), row);
-            double df = mean_diff(&png, &flipped);
+            double df = harness_mean_diff(&png, &flipped);
             SL_CHECK_MSG(df > 2 * dj, "flipped difference %.3f vs %.3f", df, dj);
         }
         sl_image_deinit(&flipped);
@@ -796,7 +762,7 @@ int main(void)
             cJSON_Delete(m);
         }
         SL_CHECK(saw_dataset && saw_bounds);
-        SL_CHECK(wait_version(&a, version) == 0);
+        SL_CHECK(tclient_wait_version(&a, version, T) == 0);
 
         /* Another technique that renders line sets, picked from the schema list (never by name). */
         const char *current = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(a.welcome, "state"),
@@ -816,7 +782,7 @@ int main(void)
             uint32_t before_id = a.max_frame_id;
             SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"%s\"}", other) == 0);
             uint32_t vo = wait_patch(&a, "technique", other);
-            SL_CHECK_MSG(vo > 0 && wait_version(&a, vo) == 0 && a.max_frame_id > before_id,
+            SL_CHECK_MSG(vo > 0 && tclient_wait_version(&a, vo, T) == 0 && a.max_frame_id > before_id,
                          "a frame from technique %s", other);
             SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"technique\":\"%s\"}", current) == 0);
         }
@@ -825,7 +791,7 @@ int main(void)
          * load_failed reaches every client of the session, without the server's path. */
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
         uint32_t vt = wait_patch(&a, "dataset", "tiny");
-        SL_CHECK(vt > 0 && wait_version(&a, vt) == 0);
+        SL_CHECK(vt > 0 && tclient_wait_version(&a, vt, T) == 0);
         SL_CHECK(unlink(objpath) == 0);
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
         e = tclient_wait_type(&a, "error", T);
@@ -840,7 +806,7 @@ int main(void)
         SL_CHECK(still_usable(&a, 5));
         SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
         vt = wait_patch(&a, "dataset", "tiny");
-        SL_CHECK(vt > 0 && wait_version(&a, vt) == 0);
+        SL_CHECK(vt > 0 && tclient_wait_version(&a, vt, T) == 0);
     }
 
     /* --- /healthz and /metrics --- */
