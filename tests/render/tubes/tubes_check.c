@@ -2,6 +2,7 @@
  *
  * usage: tubes-check --scene S.json [--set key.path=value ...] [--gpu-depth G.pfm]
  *          [--out-gpu G.pfm] [--out-png G.png] [--out-ref R.pfm] [--out-radius R.pfm] [--cubic-ref C.pfm]
+ *          [--max-cubic-dev X]
  *          [--tol 1e-3] [--rim-tol 0.05] [--max-mismatch-pct 0.5] [--ref-samples N] [--data-dir DIR]
  *          [--random-segments N --seed S] [--random-folds N --fold-axis x|y|z|any --fold-tilt T --seed S]
  *          [--write-scene OUT.json] [--culling-check]
@@ -16,7 +17,10 @@
  * or a depth error in (tol, rim-tol] x the radius; both counted, together
  * <= max-mismatch-pct % of the pixels hit by either. No NaN or Inf anywhere.
  * --cubic-ref also renders the true cubic Hermite sweep and prints how far the
- * quadratic surface lies from it. --random-segments replaces the scene's
+ * quadratic surface lies from it; --max-cubic-dev X fails the check when that
+ * distance exceeds X x the local radius on a pixel both hit away from the
+ * cubic reference's silhouettes (the approximation bound of the paper's
+ * quadratic split, asserted per dataset). --random-segments replaces the scene's
  * dataset by N random Hermite segments (chains and bifurcations, varying
  * radius and tangents) from --seed. --write-scene writes the scene as checked
  * (overrides and random dataset included) for sightline-render.
@@ -57,11 +61,12 @@ typedef struct options {
     double fold_tilt;
     unsigned long long seed;
     double tol, rim_tol, max_mismatch_pct;
+    double max_cubic_dev;  /* < 0: not checked */
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
 {
-    *o = (options){.tol = 1e-3, .rim_tol = 0.05, .max_mismatch_pct = 0.5, .fold_axis = 'x'};
+    *o = (options){.tol = 1e-3, .rim_tol = 0.05, .max_mismatch_pct = 0.5, .fold_axis = 'x', .max_cubic_dev = -1.0};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--culling-check") == 0) { o->culling_check = 1; continue; }
@@ -74,6 +79,7 @@ static int parse_args(int argc, char **argv, options *o)
         else if (strcmp(a, "--out-ref") == 0) o->out_ref = v;
         else if (strcmp(a, "--out-radius") == 0) o->out_radius = v;
         else if (strcmp(a, "--cubic-ref") == 0) o->cubic_ref = v;
+        else if (strcmp(a, "--max-cubic-dev") == 0) o->max_cubic_dev = atof(v);
         else if (strcmp(a, "--data-dir") == 0) o->data_dir = v;
         else if (strcmp(a, "--write-scene") == 0) o->write_scene = v;
         else if (strcmp(a, "--tol") == 0) o->tol = atof(v);
@@ -417,6 +423,7 @@ int main(int argc, char **argv)
     tubes_ref_render(&rd, ref, rad, seg);
     double ref_ms = sl_clock_ms() - t0;
     float *cubic = NULL;
+    int cubic_failed = 0;
     if (o.cubic_ref) {
         cubic = calloc(np, sizeof *cubic);
         float *crad = calloc(np, sizeof *crad);
@@ -424,8 +431,8 @@ int main(int argc, char **argv)
         if (cubic && crad)
             tubes_ref_render(&rd, cubic, crad, NULL);
         /* Quadratic vs cubic sweep, on pixels both hit, in units of the local radius. */
-        double mx = 0.0, mean = 0.0;
-        long both = 0, mism = 0, hit = 0;
+        double mx = 0.0, mean = 0.0, mx_away = 0.0;
+        long both = 0, mism = 0, hit = 0, away = 0;
         for (size_t k = 0; cubic && crad && k < np; k++) {
             int a = ref[k] > 0.0f, b = cubic[k] > 0.0f;
             hit += a || b;
@@ -435,10 +442,20 @@ int main(int argc, char **argv)
                 mx = fmax(mx, e);
                 mean += e;
                 both++;
+                if (!tubes_ref_silhouette(cubic, crad, w, h, (int)(k % (size_t)w), (int)(k / (size_t)w))) {
+                    mx_away = fmax(mx_away, e);
+                    away++;
+                }
             }
         }
-        printf("quadratic_vs_cubic: max %.4g mean %.4g (x local radius) over %ld pixels, coverage mismatch %ld (%.3f%%)\n",
-               mx, both ? mean / both : 0.0, both, mism, hit ? 100.0 * mism / hit : 0.0);
+        printf("quadratic_vs_cubic: max %.4g mean %.4g (x local radius) over %ld pixels, coverage mismatch %ld (%.3f%%); "
+               "away from silhouettes max %.4g over %ld pixels\n",
+               mx, both ? mean / both : 0.0, both, mism, hit ? 100.0 * mism / hit : 0.0, mx_away, away);
+        if (o.max_cubic_dev >= 0.0 && (!cubic || !crad || away == 0 || !(mx_away <= o.max_cubic_dev))) {
+            printf("quadratic_vs_cubic: FAIL: %.4g x r away from silhouettes exceeds --max-cubic-dev %g (%ld pixels)\n",
+                   mx_away, o.max_cubic_dev, away);
+            cubic_failed = 1;
+        }
         if (cubic && sl_pfm_write(o.cubic_ref, cubic, w, h, &err) != SL_OK)
             fprintf(stderr, "tubes-check: %s\n", err.message);
         free(crad);
@@ -537,8 +554,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "tubes-check: %s\n", err.message);
     if (o.out_radius && sl_pfm_write(o.out_radius, rad, w, h, &err) != SL_OK)
         fprintf(stderr, "tubes-check: %s\n", err.message);
-    if (nonfinite || inner_fail || exception_pct > o.max_mismatch_pct || hit_either == 0) {
-        printf("FAIL%s\n", hit_either == 0 ? " (nothing hit: the scene tests nothing)" : "");
+    if (nonfinite || inner_fail || exception_pct > o.max_mismatch_pct || hit_either == 0 || cubic_failed) {
+        printf("FAIL%s\n", hit_either == 0 ? " (nothing hit: the scene tests nothing)"
+                            : cubic_failed ? " (quadratic pair too far from the cubic)" : "");
         rc = 1;
     } else {
         printf("PASS\n");
