@@ -109,6 +109,13 @@ void sl_target_read_rgba(sl_target *t, uint8_t *rgba, int top_down);
 /* Reads the depth buffer (reversed-Z values), rows top-down. */
 void sl_target_read_depth(sl_target *t, float *depth);
 
+/* The GL errors raised since the last check, all drained: SL_OK, or SL_ERR_GPU
+ * naming `what` and the first error (GL_OUT_OF_MEMORY: "out of GPU memory").
+ * Techniques call it after a prepare's allocations (gl_errors.c). */
+sl_status sl_gl_check_errors(const char *what, sl_err *err);
+/* Tests only: the next sl_gl_check_errors reports `error` (as if GL had). */
+void sl_gl_inject_error(GLenum error);
+
 /* GPU timer (GL_TIME_ELAPSED query). */
 typedef struct sl_gpu_timer { GLuint query; int running; } sl_gpu_timer;
 void sl_gpu_timer_init(sl_gpu_timer *t);

@@ -152,11 +152,17 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     sl_tube_mesh_deinit(&mesh);
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
+    st = sl_gl_check_errors("lines_oit: uploading the mesh", err);
+    if (st != SL_OK) {
+        lines_oit_release(s);
+        return st;
+    }
     *out = s;
     return SL_OK;
 }
 
-static void ensure_pool(lines_oit_state *s, int w, int h, size_t nodes)
+/* The per-pixel heads and the node pool at this size; SL_ERR_GPU when GL could not allocate them. */
+static sl_status ensure_pool(lines_oit_state *s, int w, int h, size_t nodes, sl_err *err)
 {
     if (s->heads_w != w || s->heads_h != h) {
         if (s->heads_tex)
@@ -173,6 +179,10 @@ static void ensure_pool(lines_oit_state *s, int w, int h, size_t nodes)
         glNamedBufferStorage(s->nodes_buf, (GLsizeiptr)(nodes * NODE_BYTES), NULL, 0);
         s->capacity = nodes;
     }
+    sl_status st = sl_gl_check_errors("lines_oit: fragment lists", err);
+    if (st != SL_OK)
+        s->heads_w = s->heads_h = 0, s->capacity = 0; /* allocate again next frame */
+    return st;
 }
 
 static void draw_lists(lines_oit_state *s, const sl_params *params, const sl_line_style *style)
@@ -260,13 +270,16 @@ static sl_status lines_oit_render(void *opaque, const sl_view *view, const sl_pa
     size_t want = s->capacity ? s->capacity : (size_t)view->width * view->height * 8u;
     if (want > cap_nodes)
         want = cap_nodes;
-    ensure_pool(s, view->width, view->height, want);
+    st = ensure_pool(s, view->width, view->height, want, err);
+    if (st != SL_OK)
+        return st;
     sl_camera_ubo_update(&s->camera_ubo, view);
     draw_lists(s, params, &style);
     if (s->last_fragments > s->capacity && s->capacity < cap_nodes) {
         /* Grow to what this frame needs (plus a margin) and draw again. */
         size_t need = s->last_fragments + s->last_fragments / 4;
-        ensure_pool(s, view->width, view->height, need < cap_nodes ? need : cap_nodes);
+        if ((st = ensure_pool(s, view->width, view->height, need < cap_nodes ? need : cap_nodes, err)) != SL_OK)
+            return st;
         draw_lists(s, params, &style);
     }
     resolve(s, params);

@@ -182,6 +182,8 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     glGenQueries(1, &s->query);
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
+    if ((st = sl_gl_check_errors("tubes: uploading nodes and segments", err)) != SL_OK)
+        goto fail;
     s->gpu_bytes = nn * (SL_TUBES_NODE_FLOATS + 2) * sizeof(float) + ns * 2 * sizeof(uint32_t) +
                    SL_COLORMAP_TEXELS * 4;
     /* The geometry lives on the GPU now; keep only the colour scalars. */
@@ -222,13 +224,11 @@ static sl_status ensure_nearest_image(tubes_state *s, int w, int h, sl_err *err)
     if (s->nearest_tex)
         glDeleteTextures(1, &s->nearest_tex);
     s->nearest_w = s->nearest_h = 0;
-    while (glGetError() != GL_NO_ERROR)
-        ; /* report only this allocation's error */
     glCreateTextures(GL_TEXTURE_2D, 1, &s->nearest_tex);
     glTextureStorage2D(s->nearest_tex, 1, GL_R32UI, w, h);
-    GLenum gl_error = glGetError();
-    if (gl_error != GL_NO_ERROR)
-        return sl_err_set(err, SL_ERR_GPU, "tubes: nearest-hit image %dx%d failed (GL error 0x%x)", w, h, gl_error);
+    sl_status st = sl_gl_check_errors("tubes: the nearest-hit image", err);
+    if (st != SL_OK)
+        return st;
     s->nearest_w = w;
     s->nearest_h = h;
     return SL_OK;

@@ -146,6 +146,11 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     sl_tube_mesh_deinit(&mesh);
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
+    st = sl_gl_check_errors("tubes_mesh: uploading the mesh", err);
+    if (st != SL_OK) {
+        tubes_mesh_release(s);
+        return st;
+    }
     *out = s;
     return SL_OK;
 }

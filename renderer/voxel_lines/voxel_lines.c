@@ -424,6 +424,10 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    if ((st = sl_gl_check_errors("voxel_lines: uploading the voxel model", err)) != SL_OK) {
+        voxel_lines_release(s);
+        return st;
+    }
     *out = s;
     return SL_OK;
 }

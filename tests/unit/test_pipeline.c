@@ -216,6 +216,37 @@ static int render_scene_frame(sl_pipeline *pipe, const sl_scene *s, int frame, s
     return 1;
 }
 
+/* A GL out-of-memory during prepare is an error naming the technique, not a
+ * frame drawn from buffers that do not exist; nothing is kept, and the next
+ * frame prepares again and succeeds (the error is injected: it cannot be
+ * provoked on demand; every technique must check its allocations). */
+static void test_prepare_gl_error(sl_gpu *gpu, const sl_technique *t)
+{
+    sl_err err = {0};
+    sl_dataset *ds = make_dataset(t->dataset_kinds, &err);
+    sl_pipeline *pipe = NULL;
+    if (!ds || sl_pipeline_create(gpu, &pipe, &err) != SL_OK) {
+        SL_CHECK_MSG(0, "%s: setup: %s", t->name, err.message);
+        sl_dataset_destroy(ds);
+        return;
+    }
+    sl_pipeline_set_dataset(pipe, ds);
+    sl_params params;
+    sl_params_init(&params, t->params, t->param_count);
+    sl_view view;
+    SL_CHECK(sl_pipeline_set_technique(pipe, t, &params, &err) == SL_OK);
+    SL_CHECK(make_view(sl_pipeline_dataset(pipe), 30.0, W, H, &view, &err) == SL_OK);
+    sl_frame_stats stats;
+    sl_gl_inject_error(GL_OUT_OF_MEMORY);
+    sl_status st = sl_pipeline_render(pipe, &view, 1, &stats, &err);
+    SL_CHECK_MSG(st == SL_ERR_GPU && strstr(err.message, "out of GPU memory") && strstr(err.message, t->name),
+                 "%s: an injected GL_OUT_OF_MEMORY in prepare gave status %d: %s", t->name, (int)st, err.message);
+    sl_gl_inject_error(GL_NO_ERROR);
+    SL_CHECK_MSG(render(pipe, &view, 1, "after the out-of-memory", t->name) == 1,
+                 "%s: the frame after a failed prepare must prepare again", t->name);
+    sl_pipeline_destroy(pipe);
+}
+
 static void test_orbit_frames(sl_gpu *gpu)
 {
     const char *orbiting = "{\"dataset\": \"tornado\", \"orbit_frames\": 4, \"width\": 48, \"height\": 32,"
@@ -281,8 +312,10 @@ int main(void)
     int n = 0;
     const sl_technique *const *list = sl_technique_list(&n);
     SL_CHECK(n > 0);
-    for (int i = 0; i < n; i++)
+    for (int i = 0; i < n; i++) {
         test_technique(gpu, list[i]);
+        test_prepare_gl_error(gpu, list[i]);
+    }
     test_orbit_frames(gpu);
     sl_gpu_destroy(gpu);
     SL_TEST_END();
