@@ -461,6 +461,28 @@ static __attribute__((unused)) int harness_http_get(int port, const char *host, 
 }
 
 /* hello (new session when session is NULL); fills session/token/client_id. Returns 0 on welcome. */
+/* The value of metric `name` in /metrics, or -1 when absent or unreachable. */
+static __attribute__((unused)) double harness_metric(int port, const char *name)
+{
+    char body[16384], key[128];
+    if (harness_http_get(port, NULL, "/metrics", body, sizeof body) != 200)
+        return -1;
+    snprintf(key, sizeof key, "\n%s ", name);
+    const char *p = strstr(body, key);
+    return p ? atof(p + strlen(key)) : -1;
+}
+
+/* The number of field `key` in /healthz, or -1 when absent or unreachable. */
+static __attribute__((unused)) double harness_healthz_number(int port, const char *key)
+{
+    char body[2048], pat[64];
+    if (harness_http_get(port, NULL, "/healthz", body, sizeof body) != 200)
+        return -1;
+    snprintf(pat, sizeof pat, "\"%s\":", key);
+    const char *p = strstr(body, pat);
+    return p ? atof(p + strlen(pat)) : -1;
+}
+
 static __attribute__((unused)) int tclient_hello(tclient *c, const char *session, const char *token, int w, int h)
 {
     int rc;

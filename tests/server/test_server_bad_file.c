@@ -78,16 +78,6 @@ static uint32_t wait_dataset_patch(tclient *c, const char *name, int *errors)
     return 0;
 }
 
-static double metric(int port, const char *name)
-{
-    char body[16384], key[128];
-    if (harness_http_get(port, NULL, "/metrics", body, sizeof body) != 200)
-        return -1;
-    snprintf(key, sizeof key, "\n%s ", name);
-    const char *p = strstr(body, key);
-    return p ? atof(p + strlen(key)) : -1;
-}
-
 int main(void)
 {
     harness h;
@@ -200,7 +190,7 @@ int main(void)
     }
     SL_CHECK_MSG(b_frame && b_errors == 0 && !b_switched && !b.closed, "B: frame %d, errors %d, dataset changed %d",
                  b_frame, b_errors, b_switched);
-    SL_CHECK(metric(h.port, "sightline_dataset_load_failures_total") == 1);
+    SL_CHECK(harness_metric(h.port, "sightline_dataset_load_failures_total") == 1);
 
     sl_image_deinit(&before);
     sl_image_deinit(&after);

@@ -34,16 +34,6 @@ static int error_code_is(cJSON *j, const char *code, const char *field)
     return ok;
 }
 
-static double healthz_number(int port, const char *key)
-{
-    char body[2048], pat[64];
-    if (harness_http_get(port, NULL, "/healthz", body, sizeof body) != 200)
-        return -1;
-    snprintf(pat, sizeof pat, "\"%s\":", key);
-    const char *p = strstr(body, pat);
-    return p ? atof(p + strlen(pat)) : -1;
-}
-
 /* Sends a one-off camera change and waits for its still frame. */
 static int still_at(tclient *c, uint32_t seq, double azimuth)
 {
@@ -101,7 +91,7 @@ static void max_sessions(const harness *h)
     while (r > 0);
     SL_CHECK_MSG(c3.closed, "the refused hello was not closed");
     tclient_close(&c3);
-    SL_CHECK(healthz_number(h->port, "sessions") == 2);
+    SL_CHECK(harness_healthz_number(h->port, "sessions") == 2);
 
     /* The second session loses its client: the next new session takes its place. */
     tclient_close(&c2);
@@ -118,7 +108,7 @@ static void max_sessions(const harness *h)
     c3.auto_ack = 1;
     SL_CHECK(tclient_wait_frame(&c3, 0, 1, T) == 0);
     SL_CHECK(strcmp(c3.session, s2) != 0 && strcmp(c3.session, c1.session) != 0);
-    SL_CHECK(healthz_number(h->port, "sessions") == 2);
+    SL_CHECK(harness_healthz_number(h->port, "sessions") == 2);
     SL_CHECK(tclient_connect(&join, h->port, NULL) == 0);
     SL_CHECK(tclient_send(&join, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\"}", s2, t2) == 0);
     e = tclient_wait_type(&join, "error", T);

@@ -95,31 +95,11 @@ static int closed_by_server(int fd, int timeout_ms)
     }
 }
 
-static double healthz_number(int port, const char *key)
-{
-    char body[2048], pat[64];
-    if (harness_http_get(port, NULL, "/healthz", body, sizeof body) != 200)
-        return -1;
-    snprintf(pat, sizeof pat, "\"%s\":", key);
-    const char *p = strstr(body, pat);
-    return p ? atof(p + strlen(pat)) : -1;
-}
-
-static double metric(int port, const char *name)
-{
-    char body[16384], key[128];
-    if (harness_http_get(port, NULL, "/metrics", body, sizeof body) != 200)
-        return -1;
-    snprintf(key, sizeof key, "\n%s ", name);
-    const char *p = strstr(body, key);
-    return p ? atof(p + strlen(key)) : -1;
-}
-
 /* The server notices closes asynchronously: waits until /healthz shows pending == want. */
 static int wait_pending(int port, int want)
 {
     for (int i = 0; i < 100; i++) {
-        if ((int)healthz_number(port, "pending") == want)
+        if ((int)harness_healthz_number(port, "pending") == want)
             return 1;
         usleep(50000);
     }
@@ -210,7 +190,7 @@ int main(void)
     SL_CHECK_MSG(p[0] >= 0 && p[1] >= 0, "silent upgrades from 127.0.0.2: %d %d", p[0], p[1]);
     SL_CHECK_MSG(p[2] < 0, "a third pending upgrade from one address was accepted");
     SL_CHECK(wait_pending(h.port, PER_ADDRESS));
-    SL_CHECK(metric(h.port, "sightline_refused_address_total") >= 1);
+    SL_CHECK(harness_metric(h.port, "sightline_refused_address_total") >= 1);
     tclient u;
     SL_CHECK(tclient_connect(&u, h.port, NULL) == 0 && tclient_hello(&u, NULL, NULL, 32, 32) == 0);
     tclient_close(&u);
@@ -236,8 +216,8 @@ int main(void)
     double age = sl_clock_ms() - opened[0];
     SL_CHECK_MSG(evicted && age < HELLO_TIMEOUT_S * 1000 - 500, "oldest pending closed=%d at age %.0f ms", evicted, age);
     SL_CHECK_MSG(!closed_by_server(p[1], 0) && !closed_by_server(q[0], 0), "a newer pending connection was closed");
-    SL_CHECK(healthz_number(h.port, "pending") == MAX_PENDING);
-    SL_CHECK(metric(h.port, "sightline_pending_evicted_total") >= 1);
+    SL_CHECK(harness_healthz_number(h.port, "pending") == MAX_PENDING);
+    SL_CHECK(harness_metric(h.port, "sightline_pending_evicted_total") >= 1);
 
     /* --- silent connections take no client slot: with the budget full, three
      *     users are served; a fourth that upgraded in time gets `full` at hello;
@@ -248,7 +228,7 @@ int main(void)
     SL_CHECK(tclient_connect(&late, h.port, NULL) == 0);   /* pending: upgraded, no hello yet */
     SL_CHECK(tclient_connect(&users[2], h.port, NULL) == 0 && tclient_hello(&users[2], NULL, NULL, 32, 32) == 0);
     users[2].auto_ack = 1;
-    SL_CHECK(healthz_number(h.port, "clients") == MAX_CLIENTS);
+    SL_CHECK(harness_healthz_number(h.port, "clients") == MAX_CLIENTS);
     SL_CHECK(tclient_send(&late, "{\"type\":\"hello\",\"version\":1,\"width\":32,\"height\":32}") == 0);
     cJSON *e = tclient_wait_type(&late, "error", T);
     const cJSON *code = cJSON_GetObjectItemCaseSensitive(e, "code");
@@ -291,8 +271,8 @@ int main(void)
      *     connected before it keeps working, new users keep being served --- */
     tclient steady;
     SL_CHECK(user_served(h.port, &steady, 1, NULL));
-    double refused0 = metric(h.port, "sightline_refused_address_total");
-    double evicted0 = metric(h.port, "sightline_pending_evicted_total");
+    double refused0 = harness_metric(h.port, "sightline_refused_address_total");
+    double evicted0 = harness_metric(h.port, "sightline_pending_evicted_total");
     flood f = {.port = h.port};
     pthread_t th;
     pthread_create(&th, NULL, run_flood, &f);
@@ -302,7 +282,7 @@ int main(void)
     uint32_t seq = 0;
     double flood_end = sl_clock_ms() + FLOOD_MS - 1500;
     while (sl_clock_ms() < flood_end && rounds < 20) {
-        int pend = (int)healthz_number(h.port, "pending");
+        int pend = (int)harness_healthz_number(h.port, "pending");
         max_pending = pend > max_pending ? pend : max_pending;
         tclient c;
         double t0 = sl_clock_ms();
@@ -320,8 +300,8 @@ int main(void)
     }
     int steady_frame = tclient_wait_frame(&steady, seq, 1, T) == 0;
     pthread_join(th, NULL);
-    double refused1 = metric(h.port, "sightline_refused_address_total");
-    double evicted1 = metric(h.port, "sightline_pending_evicted_total");
+    double refused1 = harness_metric(h.port, "sightline_refused_address_total");
+    double evicted1 = harness_metric(h.port, "sightline_pending_evicted_total");
     printf("flood: %d upgrades from 8 addresses in %d ms, %d accepted, %d refused, %d closed by the server; "
            "%d of %d users served during it (slowest %.0f ms to welcome and first frame); max pending %d; "
            "server refused %g by address, evicted %g\n",
