@@ -24,7 +24,7 @@
 #include "../core/sl_status.h"
 #include "../data/sl_dataset.h"
 
-#define SL_VOXEL_LINE_ID_BITS 5       /* local line id: curve index mod 32 (paper: 5 bits) */
+#define SL_VOXEL_LINE_ID_MIN_BITS 5   /* local line id: at least 5 bits (the paper's), see sl_voxel_line_id_bits */
 #define SL_VOXEL_COUNT_MAX 255        /* what the 8-bit header count can express */
 #define SL_VOXEL_MAX_DIM 1024
 #define SL_VOXEL_MAX_VOXELS (512ull * 512ull * 512ull)
@@ -84,10 +84,17 @@ int sl_voxel_auto_resolution(const sl_dataset *ds);
 /* log2(N) for N a power of two in [2, 256], else -1. */
 int sl_voxel_quant_bits(int n);
 
-/* Bits and bytes of one encoded line for quantization N (= 2^k):
- * 2 * (3 + 2k) endpoint bits + 8 attribute bits + 5 line-id bits. */
+/* Bytes of one encoded line for quantization N (= 2^k): the fewest whole
+ * bytes holding 2 * (3 + 2k) endpoint bits, 8 attribute bits and 5 line-id
+ * bits (the paper's layout). The local line id then takes every bit left in
+ * those bytes (sl_voxel_line_id_bits: 10 for N = 4, 16, 64, 256; 6 for 2, 8,
+ * 32, 128), so it is the curve index mod 2^bits at no memory cost: the ray
+ * caster merges overlapping hits of one id as one tube, and a wider id makes
+ * two different curves with one id (whose tubes overlap, in a dense bundle)
+ * rarer. sl_voxel_line_bits = 8 x bytes. */
 int sl_voxel_line_bits(int k);
 int sl_voxel_line_bytes(int k);
+int sl_voxel_line_id_bits(int k);
 
 /* Bin of local point u (in [0,1]^3, on `face`) on an N x N face grid:
  * bin = q(u[s]) + N q(u[t]), s < t the two axes other than the face's,
@@ -101,11 +108,11 @@ typedef struct sl_voxel_line {
     int face_a, face_b;
     uint32_t bin_a, bin_b;
     uint32_t attr;      /* 0..255 */
-    uint32_t id;        /* 0..31 */
+    uint32_t id;        /* 0 .. 2^sl_voxel_line_id_bits(k) - 1 */
 } sl_voxel_line;
 
 /* Packs a line, least significant bit first: face_a(3) bin_a(2k) face_b(3)
- * bin_b(2k) attr(8) id(5). Fields must be in range (asserted). */
+ * bin_b(2k) attr(8) id(sl_voxel_line_id_bits(k)). Fields must be in range (asserted). */
 uint64_t sl_voxel_encode_line(int k, const sl_voxel_line *line);
 void sl_voxel_decode_line(int k, uint64_t code, sl_voxel_line *line);
 

@@ -10,7 +10,12 @@
 // holding its entry point — by then every capsule entering there was tested,
 // since its voxel is within R of that one (radius <= R voxels). Hits of one
 // curve (same local id) whose intervals overlap are one tube (the joint
-// spheres), blended once.
+// spheres), blended once: up to MAX_OPEN open tube intervals per ray (local
+// id, far end); a slot is reused only once its interval has ended before the
+// hit at hand (else the one that ended first), so a ray inside many tubes at
+// once does not forget one and blend its next piece again. Local ids are
+// curve index mod 2^bits (64 or 1024: the record's spare bits), so two
+// curves merge wrongly only when their ids collide and their tubes overlap.
 // Speed (llvmpipe runs 8 pixels in SIMD lanes whose rays visit different
 // voxels): a voxel whose box grown by the radius the ray misses is skipped
 // without reading its lines; the lines of all voxels to test at a step are
@@ -45,11 +50,43 @@ uniform int u_skip_levels;      // coarsest occupancy level used for empty-space
 
 layout(location = 0) out vec4 o_color;
 
-#define MAX_HITS 16
+#define MAX_HITS 32
 float h_in[MAX_HITS], h_out[MAX_HITS];
 vec3 h_n[MAX_HITS];
-uint h_key[MAX_HITS]; // attribute byte << 8 | local id
+uint h_key[MAX_HITS]; // attribute byte << 16 | local id
 int h_count;
+
+// Open tube intervals (joint merging): per slot a local id and the far end
+// of the merged interval along the ray.
+#define MAX_OPEN 32
+float open_out[MAX_OPEN];
+uint open_id[MAX_OPEN];
+int open_count;
+
+// Merges pending hit i into an open interval of its id that it overlaps
+// (true), or opens a new one in a slot whose interval ended before this hit
+// (or else the one that ended first).
+bool join_open(int i)
+{
+    uint hid = h_key[i] & 0xffffu;
+    int victim = 0;
+    float victim_out = 1e30;
+    for (int j = 0; j < open_count; j++) {
+        if (open_id[j] == hid && h_in[i] <= open_out[j] + 1e-4 * h_in[i]) {
+            open_out[j] = max(open_out[j], h_out[i]);
+            return true;
+        }
+        if (open_out[j] < victim_out) {
+            victim_out = open_out[j];
+            victim = j;
+        }
+    }
+    if (open_count < MAX_OPEN && victim_out >= h_in[i])
+        victim = open_count++; // no slot has ended yet: take a new one
+    open_id[victim] = hid;
+    open_out[victim] = h_out[i];
+    return false;
+}
 
 // Entry/exit of ray o + s d with the capsule a-b of radius r; false when missed.
 bool capsule(vec3 o, vec3 d, vec3 a, vec3 b, float r, out float t_in, out float t_out, out vec3 n)
@@ -102,12 +139,34 @@ bool capsule(vec3 o, vec3 d, vec3 a, vec3 b, float r, out float t_in, out float 
     return t_in < 1e29;
 }
 
+// Adds a capsule hit to the pending list (sorted by entry). A pending hit of
+// the same id whose interval it overlaps is the same tube (a joint): the two
+// become one, entered where the nearer enters, so a ray along a bundle keeps
+// one pending entry per tube crossing, not one per piece.
 void add_hit(float tin, float tout, vec3 n, uint attr, uint id)
 {
+    uint key = attr << 16u | id;
+    for (int k = 0; k < h_count; k++) {
+        if ((h_key[k] & 0xffffu) != id || tin > h_out[k] || tout < h_in[k])
+            continue;
+        h_out[k] = max(h_out[k], tout);
+        if (tin >= h_in[k])
+            return;
+        // The new piece enters first: take the merged entry out, reinsert it.
+        tout = h_out[k];
+        h_count--;
+        for (int m = k; m < h_count; m++) {
+            h_in[m] = h_in[m + 1];
+            h_out[m] = h_out[m + 1];
+            h_n[m] = h_n[m + 1];
+            h_key[m] = h_key[m + 1];
+        }
+        break;
+    }
     int i = h_count;
     if (h_count == MAX_HITS) {
         if (tin >= h_in[MAX_HITS - 1])
-            return; // keep the nearest MAX_HITS of a voxel
+            return; // keep the nearest MAX_HITS crossings
         i = MAX_HITS - 1;
     } else {
         h_count++;
@@ -122,7 +181,7 @@ void add_hit(float tin, float tout, vec3 n, uint attr, uint id)
     h_in[i] = tin;
     h_out[i] = tout;
     h_n[i] = n;
-    h_key[i] = attr << 8u | id;
+    h_key[i] = key;
 }
 
 void main()
@@ -155,14 +214,7 @@ void main()
     vec3 acc = vec3(0.0);
     float alpha = 0.0;
     float first_s = -1.0;
-    // The last composited tube interval per local id slot (joint merging).
-    float last_out[8];
-    uint last_id[8];
-    for (int i = 0; i < 8; i++) {
-        last_out[i] = -1e30;
-        last_id[i] = 0xffffffffu;
-    }
-    int last_next = 0;
+    open_count = 0;
     int steps = u_dims.x + u_dims.y + u_dims.z + 3;
     int R = u_neighbors;
     ivec3 prev = ivec3(-1000000);
@@ -260,19 +312,9 @@ void main()
             if (R > 0 && h_in[i] >= s_leave)
                 break;
             used++;
-            uint hid = h_key[i] & 255u;
-            bool merged = false;
-            for (int j = 0; j < 8; j++)
-                if (last_id[j] == hid && h_in[i] <= last_out[j] + 1e-4 * h_in[i]) {
-                    last_out[j] = max(last_out[j], h_out[i]);
-                    merged = true;
-                }
-            if (merged)
+            if (join_open(i))
                 continue;
-            last_id[last_next] = hid;
-            last_out[last_next] = h_out[i];
-            last_next = (last_next + 1) & 7;
-            float t = mix(u_attr_range.x, u_attr_range.y, float(h_key[i] >> 8u) / 255.0);
+            float t = mix(u_attr_range.x, u_attr_range.y, float(h_key[i] >> 16u) / 255.0);
             vec3 base = u_use_colormap != 0 ? sl_colormap(u_colormap, t, vec2(0.0, 1.0)) : u_color;
             vec3 pos_g = o + h_in[i] * d;
             vec3 n = normalize(h_n[i]);

@@ -1,7 +1,8 @@
 // voxel_lines_grid.glsl — access to the voxel model uploaded by voxel_lines.c:
 // per-voxel headers (32-bit offset, 8-bit count packed four per word) and the
 // bit-packed lines (voxel_grid.h: face_a(3) bin_a(2k) face_b(3) bin_b(2k)
-// attr(8) id(5), least significant bit first, line_bits per line).
+// attr(8) id(the rest of the record's bits, sl_voxel_line_id_bits), least
+// significant bit first, line_bits per line).
 // Mirrors sl_voxel_decode_line / sl_voxel_dequantize. Grid coordinates:
 // voxel (x, y, z) spans [x, x+1] x [y, y+1] x [z, z+1].
 layout(std430, binding = 1) readonly buffer sl_voxel_offsets { uint vx_offsets[]; };
@@ -54,5 +55,5 @@ void vx_line(uint index, out vec3 a, out vec3 b, out uint attr, out uint id)
     a = vx_dequantize(lo & 7u, vx_field(lo, hi, 3u, k2));
     b = vx_dequantize(vx_field(lo, hi, eb, 3u), vx_field(lo, hi, eb + 3u, k2));
     attr = vx_field(lo, hi, 2u * eb, 8u);
-    id = vx_field(lo, hi, 2u * eb + 8u, 5u);
+    id = vx_field(lo, hi, 2u * eb + 8u, uint(u_line_bits) - 2u * eb - 8u);
 }

@@ -318,7 +318,7 @@ static int collect(void *user, const sl_voxel_piece *p)
         .face_a = p->face_a, .face_b = p->face_b,
         .bin_a = sl_voxel_quantize(ua, p->face_a, b->quant),
         .bin_b = sl_voxel_quantize(ub, p->face_b, b->quant),
-        .id = p->curve & ((1u << SL_VOXEL_LINE_ID_BITS) - 1),
+        .id = p->curve & ((1u << sl_voxel_line_id_bits(b->k)) - 1),
     };
     line.attr = sl_voxel_attr_byte(p->attr_a, p->attr_b);
     if (line.face_a == line.face_b && line.bin_a == line.bin_b) {

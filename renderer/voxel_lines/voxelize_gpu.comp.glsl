@@ -124,7 +124,7 @@ void emit_piece(dvec3 p, int exit_face, double attr)
     put_bits(lo, hi, uint(g_entry_face) | (ba << 3u), 0u);
     put_bits(lo, hi, uint(exit_face) | (bb << 3u), eb);
     put_bits(lo, hi, attr_byte(g_entry_attr, attr), 2u * eb);
-    put_bits(lo, hi, g_curve & 31u, 2u * eb + 8u);
+    put_bits(lo, hi, g_curve & ((1u << uint(u_line_bits - 2 * int(eb) - 8)) - 1u), 2u * eb + 8u); // sl_voxel_line_id_bits
     int v = g_cell.x + u_dims.x * (g_cell.y + u_dims.y * g_cell.z);
     items[g_out++] = uvec4(uint(v), lo, hi, 0u);
 #endif

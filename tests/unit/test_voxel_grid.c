@@ -135,11 +135,16 @@ static void test_encode(void)
     for (int k = 1; k <= 8; k++) {
         SL_CHECK(sl_voxel_quant_bits(1 << k) == k);
         SL_CHECK_MSG(sl_voxel_line_bytes(k) == expect_bytes[k], "k=%d bytes=%d", k, sl_voxel_line_bytes(k));
+        /* The id takes the bits the whole bytes leave: never fewer than the paper's 5. */
+        int id_bits = sl_voxel_line_id_bits(k);
+        SL_CHECK_MSG(id_bits == 8 * expect_bytes[k] - 2 * (3 + 2 * k) - 8 && id_bits >= 5 && id_bits <= 10,
+                     "k=%d id bits %d", k, id_bits);
         for (int i = 0; i < 2000; i++) {
             uint32_t nb = 1u << (2 * k);
             sl_voxel_line l = {.face_a = (int)(rnd() * 6), .face_b = (int)(rnd() * 6),
                                .bin_a = (uint32_t)(rnd() * nb), .bin_b = (uint32_t)(rnd() * nb),
-                               .attr = (uint32_t)(rnd() * 256), .id = (uint32_t)(rnd() * 32)};
+                               .attr = (uint32_t)(rnd() * 256),
+                               .id = (uint32_t)(rnd() * (double)(1u << sl_voxel_line_id_bits(k)))};
             uint64_t code = sl_voxel_encode_line(k, &l);
             SL_CHECK(code < (1ull << sl_voxel_line_bits(k)));
             sl_voxel_line d;
@@ -480,10 +485,14 @@ static void test_overflow(void)
     SL_CHECK(g.counts[v1] == 255 && g.counts[v2] == 255); /* capped, not 301 mod 256 = 45 */
     SL_CHECK(g.capped_voxels == 2);
     SL_CHECK(g.dropped_overflow == (301 - 255) + (300 - 255));
-    /* The kept lines are the first in curve order: ids 0..31 cycling from curve 0. */
+    /* The kept lines are the first in curve order: ids cycle from curve 0
+     * with the record's 6 id bits at N = 128 (0..63). */
     sl_voxel_line l;
+    SL_CHECK(sl_voxel_line_id_bits(g.quant_bits) == 6);
     sl_voxel_decode_line(g.quant_bits, sl_voxel_grid_line(&g, g.offsets[v2] + 40), &l);
-    SL_CHECK(l.id == 40 % 32);
+    SL_CHECK(l.id == 40);
+    sl_voxel_decode_line(g.quant_bits, sl_voxel_grid_line(&g, g.offsets[v2] + 100), &l);
+    SL_CHECK(l.id == 100 % 64);
     sl_voxel_grid_deinit(&g);
     desc.max_per_voxel = 10;
     SL_CHECK(sl_voxel_grid_build(&g, ds, &desc, &err) == SL_OK);
