@@ -159,8 +159,10 @@ sl_status sl_params_check_attributes(const sl_params *p, int count, sl_err *err)
 {
     for (int i = 0; i < p->count; i++) {
         const sl_param_def *d = &p->schema[i];
-        int v = (int)p->value[i][0];
-        if (d->type != SL_PARAM_ATTRIBUTE || v < count || p->value[i][0] == d->def[0])
+        if (d->type != SL_PARAM_ATTRIBUTE)
+            continue;
+        int v = (int)p->value[i][0]; /* an integer in the schema's small range */
+        if (v < count || p->value[i][0] == d->def[0])
             continue;
         return sl_err_set(err, SL_ERR_INVALID, "params.%s = %d: the dataset has %d per-vertex attribute%s "
                           "(valid: %d .. %d)", d->name, v, count, count == 1 ? "" : "s", (int)d->min, count - 1);

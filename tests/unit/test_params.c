@@ -596,6 +596,14 @@ static void test_attributes(void)
     SL_CHECK_MSG(strcmp(err.message, "params.a = 1: the dataset has 1 per-vertex attribute (valid: -1 .. 0)") == 0,
                  "%s", err.message);
     SL_CHECK(sl_params_check_attributes(&p, 2, &err) == SL_OK);
+    /* Other parameters' values are never read as indices (a float at -1e30 is no int). */
+    const sl_technique *t = sl_technique_find("tubes_mesh");
+    SL_CHECK(t != NULL);
+    if (t) {
+        sl_params_init(&p, t->params, t->param_count);
+        SL_CHECK(sl_params_set_numbers(&p, "scalar_min", (double[]){-1e30}, 1, &err) == SL_OK);
+        SL_CHECK_MSG(sl_params_check_attributes(&p, 1, &err) == SL_OK, "%s", err.message);
+    }
 }
 
 /* The technique schemas' shared names: a few declared facts the rest of the code relies on. */
