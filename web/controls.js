@@ -121,6 +121,7 @@ export class ParamControls {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
           f.type = 'number';
+          f.name = def.name; // update() leaves a focused control alone, by name
           f.step = 'any';
           f.min = def.min; f.max = def.max;
           f.className = 'vec';
