@@ -49,31 +49,16 @@ static void camera_json(char *out, size_t size, const scene_case *c, double azim
              azimuth, c->elevation, c->distance, c->fov_y);
 }
 
-/* Renders the case with sightline-render into dir/name.png; 0 and the image, or -1. */
+/* Renders the case with sightline-render at the given azimuth; 0 and the image, or -1. */
 static int cli_render(const harness *h, const scene_case *c, double azimuth, const char *name, sl_image *out)
 {
-    char scene_path[400], png_path[400], camera[256], exe[1024];
-    snprintf(scene_path, sizeof scene_path, "%s/%s.json", h->dir, name);
-    snprintf(png_path, sizeof png_path, "%s/%s.png", h->dir, name);
+    char camera[256], scene[1024];
     camera_json(camera, sizeof camera, c, azimuth);
-    FILE *f = fopen(scene_path, "w");
-    if (!f)
-        return -1;
-    fprintf(f, "{\"dataset\":%s,\"technique\":\"%s\",\"params\":%s,\"camera\":%s,\"width\":%d,\"height\":%d,"
-               "\"background\":%s}\n", HARNESS_TINY, c->technique, c->params, camera, W, H, BACKGROUND);
-    if (fclose(f) != 0)
-        return -1;
-    const char *bin = getenv("SIGHTLINE_BINARY_DIR");
-    snprintf(exe, sizeof exe, "%s/bin/sightline-render", bin ? bin : "build");
-    char *argv[] = {exe, "--scene", scene_path, "--out", png_path, "--samples", "1", NULL};
-    int rc = harness_run_wait(argv);
-    SL_CHECK_MSG(rc == 0, "sightline-render (%s) exited %d", name, rc);
-    sl_err err = {0};
-    if (rc != 0 || sl_png_read(png_path, out, &err) != SL_OK) {
-        fprintf(stderr, "%s: %s\n", png_path, err.message);
-        return -1;
-    }
-    return 0;
+    snprintf(scene, sizeof scene, "{\"dataset\":%s,\"technique\":\"%s\",\"params\":%s,\"camera\":%s,\"width\":%d,"
+             "\"height\":%d,\"background\":%s}\n", HARNESS_TINY, c->technique, c->params, camera, W, H, BACKGROUND);
+    int rc = harness_cli_render(h, scene, name, out);
+    SL_CHECK_MSG(rc == 0, "sightline-render (%s) rendered", name);
+    return rc;
 }
 
 /* Waits for the PNG snapshot; 0 and the decoded image, or -1. Counts error messages. */
