@@ -80,6 +80,11 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
         }
         return sl_params_set_numbers(p, name, v, 3, err);
     }
+    case SL_PARAM_ATTRIBUTE:
+        if (!cJSON_IsNumber(item))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an attribute index in [%g, %g]%s", name,
+                              d->min, d->max, d->min < 0 ? " (-1 = none)" : "");
+        return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
         if (!cJSON_IsNumber(item))
@@ -112,7 +117,8 @@ static cJSON *value_json(const sl_param_def *d, const double v[3])
     case SL_PARAM_ENUM: return cJSON_CreateString(d->choices[(int)v[0]]);
     case SL_PARAM_VEC3: return cJSON_CreateDoubleArray(v, 3);
     case SL_PARAM_FLOAT:
-    case SL_PARAM_INT: return cJSON_CreateNumber(v[0]);
+    case SL_PARAM_INT:
+    case SL_PARAM_ATTRIBUTE: return cJSON_CreateNumber(v[0]);
     }
     return cJSON_CreateNull();
 }
@@ -144,7 +150,8 @@ cJSON *sl_params_schema_json(const sl_param_def *schema, int count)
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", d->name);
         cJSON_AddStringToObject(o, "type", sl_param_type_name(d->type));
-        if (d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3) {
+        if (d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3 ||
+            d->type == SL_PARAM_ATTRIBUTE) {
             cJSON_AddNumberToObject(o, "min", d->min);
             cJSON_AddNumberToObject(o, "max", d->max);
         }

@@ -1,7 +1,7 @@
 /* sl_params_json.h — technique parameters to and from JSON.
  *
- * Values: numbers (float, int), true/false (bool), a choice name (enum),
- * [x, y, z] (vec3). A patch is applied all-or-nothing: on the first unknown
+ * Values: numbers (float, int, attribute: an index, -1 = none), true/false
+ * (bool), a choice name (enum), [x, y, z] (vec3). A patch is applied all-or-nothing: on the first unknown
  * name, wrong type, out-of-range value or NaN, nothing changes and err names
  * the parameter and its allowed range. Any thread.
  */
@@ -16,7 +16,8 @@
 sl_status sl_params_apply_json(sl_params *params, const cJSON *patch, sl_err *err);
 /* {"name": value, ...} of every parameter. */
 cJSON *sl_params_to_json(const sl_params *params);
-/* The schema as a JSON array of {name, type, min, max, default, choices, unit, description, invalidates}. */
+/* The schema as a JSON array of {name, type, min, max, default, choices, unit, description, invalidates};
+ * min/max for float, int, vec3 and attribute (min -1: -1 = none), choices for enum. */
 cJSON *sl_params_schema_json(const sl_param_def *schema, int count);
 /* {name, description, dataset_kinds: [...], params: schema} */
 cJSON *sl_technique_json(const sl_technique *t);

@@ -85,17 +85,17 @@ function datasetByName(name) {
   return app.datasets.find((d) => d.name === name);
 }
 
-// Labels for parameters whose values name parts of the dataset: the
-// attribute names the catalog knows (null until a built-in was first made).
-function paramLabels() {
+// The dataset's attribute names, the options of 'attribute' parameters
+// (null until the catalog has described the dataset, e.g. a built-in not made yet).
+function attributeNames() {
   const names = datasetByName(app.state?.dataset)?.attributes;
-  return Array.isArray(names) && names.length ? { attribute: names, radius_attribute: names } : {};
+  return Array.isArray(names) ? names : null;
 }
 
 function buildParams() {
   const t = techniqueByName(app.state?.technique);
   if (!t) return;
-  params.build(t.params || [], paramLabels());
+  params.build(t.params || [], attributeNames());
   params.update(app.state.params);
 }
 

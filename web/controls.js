@@ -1,10 +1,11 @@
 // controls.js — parameter controls generated from a technique's schema
 // (sl_params_schema_json: name, type, min, max, default, choices, unit,
 // description). float/int -> slider + value with unit, bool -> checkbox,
-// enum -> select (colormaps too), vec3 -> three number fields; an int whose
-// values have labels (the dataset's attribute names) -> select. Descriptions
-// become tooltips; a slider also shows its range and unit ("0 … 1000 world")
-// beside the value and in its tooltip. Knows nothing about techniques by name.
+// enum -> select (colormaps too), vec3 -> three number fields, attribute ->
+// select of the dataset's attribute names ("none" = -1 when min is -1).
+// Descriptions become tooltips; a slider also shows its range and unit
+// ("0 … 1000 world") beside the value and in its tooltip. Knows no
+// technique or parameter by name: the schema's type alone picks the control.
 
 function fmt(v, type) {
   if (type === 'int') return String(Math.round(v));
@@ -30,6 +31,29 @@ function scaleFor(def) {
   };
 }
 
+// A select of attribute names for one 'attribute' parameter; returns its
+// set(value). Names not known yet: only "none" and the current index, until
+// build() is called again with the names. A value the dataset lacks (the
+// default 0 on a dataset without attributes, which renders as none) shows
+// as "none" when there is one.
+function attributeSelect(row, def, names, onChange) {
+  const sel = document.createElement('select');
+  sel.name = def.name;
+  sel.dataset.type = 'attribute';
+  const known = Array.isArray(names);
+  if (def.min < 0) sel.append(new Option('none', '-1'));
+  if (known) names.forEach((label, i) => { if (i <= def.max) sel.append(new Option(label, String(i))); });
+  else sel.title = 'attribute names arrive once the dataset has loaded';
+  sel.addEventListener('change', () => onChange(Number(sel.value)));
+  row.append(sel);
+  return (v) => {
+    const want = String(v < 0 ? -1 : v);
+    if (!known && v >= 0 && ![...sel.options].some((o) => o.value === want)) sel.append(new Option(`#${v}`, want));
+    sel.value = want;
+    if (sel.value !== want && def.min < 0) sel.value = '-1';
+  };
+}
+
 export class ParamControls {
   // onChange(name, value) is called when the user changes a control.
   constructor(form, onChange) {
@@ -39,11 +63,11 @@ export class ParamControls {
     this.schemaKey = '';
   }
 
-  // labels: optional { paramName: [label of value 0, label of value 1, ...] }
-  // for int parameters whose values name things (the dataset's attributes);
-  // such a parameter becomes a select, with "none" for a value below 0.
-  build(schema, labels = {}) {
-    const key = JSON.stringify([schema.map((d) => d.name), labels]);
+  // attributes: the dataset's per-vertex attribute names in index order
+  // (null while the catalog does not know them yet), the options of every
+  // parameter of type 'attribute'.
+  build(schema, attributes = null) {
+    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     this.form.replaceChildren();
@@ -57,15 +81,8 @@ export class ParamControls {
       name.textContent = def.name;
       row.append(name);
       let entry;
-      const names = labels[def.name];
-      if (def.type === 'int' && Array.isArray(names) && names.length) {
-        const sel = document.createElement('select');
-        sel.name = def.name;
-        if (def.min < 0) sel.append(new Option('none', '-1'));
-        names.forEach((label, i) => { if (i <= def.max) sel.append(new Option(label, String(i))); });
-        sel.addEventListener('change', () => this.onChange(def.name, Number(sel.value)));
-        row.append(sel);
-        entry = { def, set: (v) => { sel.value = String(v < 0 ? -1 : v); } };
+      if (def.type === 'attribute') {
+        entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
       } else if (def.type === 'float' || def.type === 'int') {
         const sc = scaleFor(def);
         const slider = document.createElement('input');
@@ -104,6 +121,7 @@ export class ParamControls {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
           f.type = 'number';
+          f.name = def.name; // update() leaves a focused control alone, by name
           f.step = 'any';
           f.min = def.min; f.max = def.max;
           f.className = 'vec';

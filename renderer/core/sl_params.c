@@ -73,6 +73,11 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
                 return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes a choice index in [0, %d]", name, nc - 1);
             break;
         }
+        case SL_PARAM_ATTRIBUTE:
+            if (v[k] != floor(v[k]) || v[k] < d->min || v[k] > d->max)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes an attribute index in [%g, %g]%s, got %g",
+                                  name, d->min, d->max, d->min < 0 ? " (-1 = none)" : "", v[k]);
+            break;
         case SL_PARAM_INT:
             if (v[k] != floor(v[k]))
                 return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer in [%g, %g], got %g",
@@ -98,7 +103,7 @@ sl_status sl_params_set_choice(sl_params *p, const char *name, const char *choic
         return unknown_parameter(p, name, err);
     const sl_param_def *d = &p->schema[i];
     if (d->type != SL_PARAM_ENUM)
-        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' is a %s, not a choice", name, sl_param_type_name(d->type));
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes no choice name", name, sl_param_type_name(d->type));
     char list[400] = "";
     size_t used = 0;
     for (int k = 0; d->choices[k]; k++) {
@@ -144,6 +149,27 @@ bool sl_params_bool(const sl_params *p, const char *name)
     return i < 0 ? false : p->value[i][0] != 0.0;
 }
 
+int sl_params_attribute(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_ATTRIBUTE);
+    return i < 0 ? -1 : (int)p->value[i][0];
+}
+
+sl_status sl_params_check_attributes(const sl_params *p, int count, sl_err *err)
+{
+    for (int i = 0; i < p->count; i++) {
+        const sl_param_def *d = &p->schema[i];
+        if (d->type != SL_PARAM_ATTRIBUTE)
+            continue;
+        int v = (int)p->value[i][0]; /* an integer in the schema's small range */
+        if (v < count || p->value[i][0] == d->def[0])
+            continue;
+        return sl_err_set(err, SL_ERR_INVALID, "params.%s = %d: the dataset has %d per-vertex attribute%s "
+                          "(valid: %d .. %d)", d->name, v, count, count == 1 ? "" : "s", (int)d->min, count - 1);
+    }
+    return SL_OK;
+}
+
 int sl_params_choice(const sl_params *p, const char *name)
 {
     int i = checked_index(p, name, SL_PARAM_ENUM);
@@ -182,6 +208,7 @@ const char *sl_param_type_name(sl_param_type t)
     case SL_PARAM_BOOL: return "bool";
     case SL_PARAM_ENUM: return "enum";
     case SL_PARAM_VEC3: return "vec3";
+    case SL_PARAM_ATTRIBUTE: return "attribute";
     }
     return "unknown";
 }

@@ -22,6 +22,10 @@ typedef enum sl_param_type {
     SL_PARAM_BOOL,  /* 0 or 1 */
     SL_PARAM_ENUM,  /* index into choices (given and reported by name) */
     SL_PARAM_VEC3,  /* three doubles, each in [min, max] (directions, colours) */
+    SL_PARAM_ATTRIBUTE, /* index of one of the dataset's per-vertex attributes, an
+                           integer in [min, max]; min is -1 (then -1 = none) or 0.
+                           The schema bounds every dataset; sl_params_check_attributes
+                           narrows it to the dataset's count. Given as a number. */
 } sl_param_type;
 
 /* Ordered: a larger level implies every smaller one. */
@@ -66,9 +70,18 @@ sl_status sl_params_set_choice(sl_params *p, const char *name, const char *choic
 double sl_params_float(const sl_params *p, const char *name);
 int sl_params_int(const sl_params *p, const char *name);
 bool sl_params_bool(const sl_params *p, const char *name);
+int sl_params_attribute(const sl_params *p, const char *name);    /* attribute index, -1 = none */
 int sl_params_choice(const sl_params *p, const char *name);       /* enum index */
 const char *sl_params_choice_name(const sl_params *p, const char *name);
 void sl_params_vec3(const sl_params *p, const char *name, float out[3]);
+
+/* Checks every SL_PARAM_ATTRIBUTE value against a dataset with `count`
+ * per-vertex attributes: SL_OK when each is -1, below count, or its schema
+ * default (a default of 0 means "the first attribute, if any" and reads as
+ * none on a dataset without attributes); else SL_ERR_INVALID naming the
+ * first offender: "params.NAME = V: the dataset has N per-vertex attributes
+ * (valid: -1 .. N-1)". */
+sl_status sl_params_check_attributes(const sl_params *p, int count, sl_err *err);
 
 /* The largest invalidation level among parameters whose values differ.
  * Both must share one schema; a schema change counts as PREPARED. */

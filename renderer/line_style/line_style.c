@@ -8,18 +8,7 @@
 
 sl_status sl_line_style_check(const sl_params *p, const sl_dataset *ds, sl_err *err)
 {
-    int count = ds->kind == SL_DATASET_LINES ? ds->lines.attribute_count : 0;
-    int a = sl_params_int(p, "attribute");
-    if (a >= count && !(a == 0 && count == 0))
-        return sl_err_set(err, SL_ERR_INVALID, "params.attribute = %d: the dataset has %d per-vertex attribute%s "
-                          "(valid: -1 .. %d)", a, count, count == 1 ? "" : "s", count - 1);
-    if (sl_params_find(p, "radius_attribute") >= 0) {
-        int r = sl_params_int(p, "radius_attribute");
-        if (r >= count)
-            return sl_err_set(err, SL_ERR_INVALID, "params.radius_attribute = %d: the dataset has %d per-vertex "
-                              "attribute%s (valid: -1 .. %d)", r, count, count == 1 ? "" : "s", count - 1);
-    }
-    return SL_OK;
+    return sl_params_check_attributes(p, ds->kind == SL_DATASET_LINES ? ds->lines.attribute_count : 0, err);
 }
 
 void sl_line_style_read(const sl_params *p, const sl_dataset *ds, sl_line_style *s)
@@ -28,10 +17,10 @@ void sl_line_style_read(const sl_params *p, const sl_dataset *ds, sl_line_style 
     if (!(s->radius > 0.0f))
         s->radius = (float)(sl_dataset_radius(ds) / 300.0);
     s->radius_scale = (float)sl_params_float(p, "radius_scale");
-    s->attribute = sl_params_int(p, "attribute");
+    s->attribute = sl_params_attribute(p, "attribute");
     if (ds->kind != SL_DATASET_LINES || s->attribute >= ds->lines.attribute_count)
         s->attribute = -1;
-    s->radius_attribute = sl_params_find(p, "radius_attribute") >= 0 ? sl_params_int(p, "radius_attribute") : -1;
+    s->radius_attribute = sl_params_find(p, "radius_attribute") >= 0 ? sl_params_attribute(p, "radius_attribute") : -1;
     if (ds->kind != SL_DATASET_LINES || s->radius_attribute >= ds->lines.attribute_count)
         s->radius_attribute = -1;
     s->colormap = sl_params_choice(p, "colormap");

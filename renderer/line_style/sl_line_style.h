@@ -25,7 +25,7 @@ struct sl_dataset;
      "tube radius where the data gives none; 0 = automatic (1/300 of the data's bounding radius)", SL_INVALIDATE_FRAME}, \
     {"radius_scale", SL_PARAM_FLOAT, 0.0, 1000.0, {1}, NULL, "", \
      "factor on radii that the data gives", SL_INVALIDATE_FRAME}, \
-    {"attribute", SL_PARAM_INT, -1, 31, {0}, NULL, "", \
+    {"attribute", SL_PARAM_ATTRIBUTE, -1, 31, {0}, NULL, "", \
      "index of the per-vertex attribute that drives colour; -1 = constant colour", SL_INVALIDATE_FRAME}, \
     {"colormap", SL_PARAM_ENUM, 0, 0, {0}, sl_colormap_names, "", \
      "colormap for the attribute", SL_INVALIDATE_FRAME}, \
@@ -48,7 +48,7 @@ struct sl_dataset;
  * tube with the one `radius` (voxel_lines, lines_oit, as in their paper)
  * leave it out, so a scene cannot ask them for what they do not do. */
 #define SL_LINE_STYLE_RADIUS_ATTRIBUTE_PARAM \
-    {"radius_attribute", SL_PARAM_INT, -1, 31, {-1}, NULL, "", \
+    {"radius_attribute", SL_PARAM_ATTRIBUTE, -1, 31, {-1}, NULL, "", \
      "index of the per-vertex attribute that gives the tube radius (|value| x radius_scale); -1 = the data's radii, " \
      "else radius", SL_INVALIDATE_PREPARED}
 
@@ -65,7 +65,8 @@ typedef struct sl_line_style {
 } sl_line_style;
 
 /* SL_OK, or SL_ERR_INVALID naming the parameter, its value and the number of
- * attributes when `attribute` or `radius_attribute` names an attribute the
+ * attributes when an attribute parameter (`attribute`, `radius_attribute`:
+ * SL_PARAM_ATTRIBUTE, sl_params_check_attributes) names an attribute the
  * dataset does not have. The default attribute 0 on a dataset without
  * attributes is accepted (constant colour): it means "the first, if any". */
 sl_status sl_line_style_check(const sl_params *params, const struct sl_dataset *ds, sl_err *err);

@@ -123,7 +123,7 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1, &s->nodes, err);
     if (st != SL_OK)
         goto fail;
-    sl_tubes_nodes_set_radii(&ds->lines, sl_params_int(params, "radius_attribute"), &s->nodes);
+    sl_tubes_nodes_set_radii(&ds->lines, sl_params_attribute(params, "radius_attribute"), &s->nodes);
     for (size_t k = 0; k < s->nodes.segment_count; k++) {
         const float *a = s->nodes.geometry + (size_t)s->nodes.segments[2 * k] * SL_TUBES_NODE_FLOATS;
         const float *b = s->nodes.geometry + (size_t)s->nodes.segments[2 * k + 1] * SL_TUBES_NODE_FLOATS;

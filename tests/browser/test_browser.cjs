@@ -7,7 +7,18 @@
 // changes a parameter through its generated control and sees the session
 // state and a newer frame; opens the share link in a second page, which
 // joins as a viewer and shows the same frame id with identical pixels.
-// Screenshots go to <source>/build/ (CI artifact). Prints "N passed, N failed".
+// Every control kind is driven as a user would (click, select, keys, typing)
+// and the value that reached the server is read back by an observer: a raw
+// WebSocket that joins the session on its own (no app.js) and reads the
+// server's full state from `welcome`, polled until it holds the expected
+// value (so a wrong value sent by the page times out and fails): checkbox,
+// enum, int and float sliders, vec3 fields, attribute selects (built from
+// the schema type alone; also checked on a synthetic schema), technique and
+// dataset pickers, "load view" (the saved view's dataset, technique, params
+// and camera come back), and control hand-over to the second page (request,
+// grant, the new controller's change reaches the server, the old one's
+// controls are disabled). Screenshots go to <source>/build/ (CI artifact).
+// Prints "N passed, N failed".
 'use strict';
 
 const { chromium } = require('playwright-core');
@@ -20,7 +31,9 @@ const SRC = process.env.SIGHTLINE_SOURCE_DIR || path.resolve(__dirname, '../..')
 const BIN = process.env.SIGHTLINE_BINARY_DIR || path.join(SRC, 'build');
 const SERVER = path.join(BIN, 'bin', 'sightline-server');
 const TINY = '{"generator":"tornado","lines":40,"points":40,"seed":3}';
+const TINY2 = '{"generator":"abc","lines":30,"points":40,"seed":2}';
 const T = 30000;
+const ARTIFACTS = path.join(SRC, 'build');
 
 let passed = 0, failed = 0;
 function check(cond, what) {
@@ -34,6 +47,7 @@ function startServer(dir, port = 0) {
   if (!fs.existsSync(data)) {
     fs.mkdirSync(data);
     execFileSync(SERVER, ['catalog', 'add-generator', 'tiny', TINY, '--db', db, '--data-dir', data], { stdio: 'ignore' });
+    execFileSync(SERVER, ['catalog', 'add-generator', 'tiny2', TINY2, '--db', db, '--data-dir', data], { stdio: 'ignore' });
   }
   const proc = spawn(SERVER, ['--port', String(port), '--db', db, '--data-dir', data, '--web-dir', path.join(SRC, 'web'),
     '--default-dataset', 'tiny'], { stdio: ['ignore', 'pipe', 'inherit'] });
@@ -63,6 +77,210 @@ function canvasStats(page) {
   });
 }
 
+// The session's state as the server holds it: a raw WebSocket in the observer
+// page joins the session (hello with id and token), takes `welcome` (state
+// and the catalog's datasets) and closes. Independent of app.js.
+function observeWelcome(obs, session, token) {
+  return obs.evaluate(([sid, tok]) => new Promise((resolve, reject) => {
+    const ws = new WebSocket(`ws://${location.host}/ws`, 'sightline.v1');
+    const timer = setTimeout(() => { ws.close(); reject(new Error('observer: no welcome in 10 s')); }, 10000);
+    ws.onopen = () => ws.send(JSON.stringify({ type: 'hello', version: 1, session: sid, token: tok }));
+    ws.onmessage = (ev) => {
+      if (typeof ev.data !== 'string') return;
+      const m = JSON.parse(ev.data);
+      if (m.type !== 'welcome' && m.type !== 'error') return;
+      clearTimeout(timer);
+      ws.close();
+      if (m.type === 'welcome') resolve({ state: m.state, datasets: m.datasets });
+      else reject(new Error(`observer: ${m.code}: ${m.message}`));
+    };
+    ws.onerror = () => { clearTimeout(timer); reject(new Error('observer: WebSocket error')); };
+  }), [session, token]);
+}
+
+async function observeOnce(obs, session, token) {
+  return (await observeWelcome(obs, session, token)).state;
+}
+
+// Polls the server's state until pred(state) holds (then returns it) or
+// `ms` pass (then returns null and the last state is printed).
+async function serverStateWhere(obs, sess, pred, what, ms = 15000) {
+  const deadline = Date.now() + ms;
+  let st = null;
+  for (;;) {
+    st = await observeOnce(obs, sess.session, sess.token);
+    if (pred(st)) return st;
+    if (Date.now() > deadline) break;
+    await new Promise((r) => setTimeout(r, 150));
+  }
+  console.error(`${what}: server state never matched; last: ${JSON.stringify({ dataset: st.dataset,
+    technique: st.technique, params: st.params, controller: st.controller })}`);
+  return null;
+}
+
+// Waits until the page shows a still frame of its newest state version.
+function settled(page) {
+  return page.waitForFunction(() => window.sightline.lastFrame && !window.sightline.lastFrame.interactive &&
+    window.sightline.lastFrame.stateVersion >= window.sightline.stateVersion, null, { timeout: T });
+}
+
+const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
+
+// Every control kind through the page, each value read back from the server.
+async function driveControls(page, obs, sess, saved) {
+  const schemaOf = (name) => page.evaluate((n) => window.sightline.techniques.find((t) => t.name === n).params, name);
+  const banner = async () => ((await page.isHidden('#banner')) ? '' : page.textContent('#banner'));
+  let schema = await schemaOf('tubes_mesh');
+  let st = await observeOnce(obs, sess.session, sess.token);
+  check(st.technique === 'tubes_mesh' && st.dataset === 'tiny', `starts on tiny/tubes_mesh (${st.dataset}/${st.technique})`);
+
+  // Checkbox: a click flips the bool on the server.
+  const bool = schema.find((d) => d.type === 'bool');
+  const was = st.params[bool.name];
+  await page.click(`#params input[type=checkbox][name=${bool.name}]`);
+  check(await serverStateWhere(obs, sess, (s) => s.params[bool.name] === !was, `checkbox ${bool.name}`),
+    `checkbox ${bool.name}: ${was} -> ${!was} on the server`);
+
+  // Enum: a choice picked in the select is the server's value.
+  const en = schema.find((d) => d.type === 'enum');
+  const choice = en.choices.find((c) => c !== st.params[en.name] && c !== en.default) || en.choices[0];
+  await page.selectOption(`#params select[name=${en.name}]`, choice);
+  check(await serverStateWhere(obs, sess, (s) => s.params[en.name] === choice, `enum ${en.name}`),
+    `enum ${en.name} = ${choice} on the server`);
+
+  // Int slider by keyboard: End, then one step down = max - 1.
+  const int = schema.find((d) => d.type === 'int');
+  await page.focus(`#params input[type=range][name=${int.name}]`);
+  await page.keyboard.press('End');
+  await page.keyboard.press('ArrowLeft');
+  check(await serverStateWhere(obs, sess, (s) => s.params[int.name] === int.max - 1, `int slider ${int.name}`),
+    `int slider ${int.name} = ${int.max - 1} (max - 1) on the server`);
+  // Float slider (linear scale) by keyboard: Home = min exactly.
+  const log = (d) => d.min >= 0 && d.max > 1000 * Math.max(d.min, 1e-6);
+  const flt = schema.find((d) => d.type === 'float' && !log(d) && d.default !== d.min);
+  await page.focus(`#params input[type=range][name=${flt.name}]`);
+  await page.keyboard.press('Home');
+  check(await serverStateWhere(obs, sess, (s) => s.params[flt.name] === flt.min, `float slider ${flt.name}`),
+    `float slider ${flt.name} = ${flt.min} (min) on the server`);
+
+  // Vector: three typed components, each committed with Tab.
+  const vec = schema.find((d) => d.type === 'vec3' && d.min <= 0.25 && d.max >= 0.75);
+  const want = [0.25, 0.5, 0.75];
+  const fields = page.locator(`#params input.vec[name=${vec.name}]`);
+  check((await fields.count()) === 3, `vec3 ${vec.name} has three fields`);
+  for (let k = 0; k < 3; k++) {
+    await fields.nth(k).fill(String(want[k]));
+    await fields.nth(k).press('Tab');
+  }
+  check(await serverStateWhere(obs, sess, (s) => same(s.params[vec.name], want), `vec3 ${vec.name}`),
+    `vec3 ${vec.name} = ${JSON.stringify(want)} on the server`);
+
+  // Attribute selects: built for every 'attribute' parameter, listing the
+  // dataset's attribute names (from the server's catalog) after "none".
+  const names = (await observeWelcome(obs, sess.session, sess.token)).datasets.find((d) => d.name === 'tiny').attributes;
+  check(Array.isArray(names) && names.length >= 1, `the server lists tiny's attributes ${JSON.stringify(names)}`);
+  const attrParams = schema.filter((d) => d.type === 'attribute');
+  check(attrParams.length >= 2, `tubes_mesh has attribute parameters ${attrParams.map((d) => d.name)}`);
+  for (const d of attrParams) {
+    const opts = await page.$$eval(`#params select[name=${d.name}] option`, (os) => os.map((o) => o.textContent));
+    check(same(opts, ['none', ...names]), `${d.name} select lists none + ${JSON.stringify(names)}: ${JSON.stringify(opts)}`);
+  }
+  await page.selectOption('#params select[name=attribute]', { label: 'none' });
+  check(await serverStateWhere(obs, sess, (s) => s.params.attribute === -1, 'attribute none'), 'attribute "none" = -1 on the server');
+  await page.selectOption('#params select[name=radius_attribute]', { label: names[names.length - 1] });
+  check(await serverStateWhere(obs, sess, (s) => s.params.radius_attribute === names.length - 1, 'radius_attribute'),
+    `radius_attribute "${names[names.length - 1]}" = ${names.length - 1} on the server`);
+  await page.selectOption('#params select[name=attribute]', { label: names[0] });
+  check(await serverStateWhere(obs, sess, (s) => s.params.attribute === 0, 'attribute 0'), `attribute "${names[0]}" = 0 on the server`);
+  await settled(page);
+  check((await banner()) === '', `no error after the control changes (${await banner()})`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-controls.png') });
+
+  // Technique picker: the server switches, the controls follow the new schema.
+  const tech = 'tubes';
+  await page.selectOption('#technique', tech);
+  st = await serverStateWhere(obs, sess, (s) => s.technique === tech, 'technique');
+  check(st, `technique ${tech} on the server`);
+  await page.waitForFunction((n) => window.sightline.state.technique === n, tech, { timeout: T });
+  schema = await schemaOf(tech);
+  const shown = await page.$$eval('#params label.param span.name', (xs) => xs.map((x) => x.textContent));
+  check(same(shown, schema.map((d) => d.name)), `controls follow the ${tech} schema (${shown.length} of ${schema.length})`);
+  check(st && same(Object.keys(st.params).sort(), schema.map((d) => d.name).sort()), `server params are ${tech}'s`);
+  await settled(page);
+
+  // Dataset picker: a second catalog entry; its attributes fill the selects.
+  await page.selectOption('#dataset', 'tiny2');
+  st = await serverStateWhere(obs, sess, (s) => s.dataset === 'tiny2' && Array.isArray(s.bounds), 'dataset');
+  check(st && st.technique === tech, `dataset tiny2 on the server, technique kept (${st && st.technique})`);
+  await page.waitForFunction(() => window.sightline.state.dataset === 'tiny2', null, { timeout: T });
+  await settled(page);
+  check((await banner()) === '', `no error after the dataset switch (${await banner()})`);
+
+  // Load view: the saved view's dataset, technique, params and camera return.
+  await page.selectOption('#views', saved.name);
+  await page.click('#load-view');
+  st = await serverStateWhere(obs, sess, (s) => s.dataset === saved.state.dataset && s.technique === saved.state.technique &&
+    same(s.params, saved.state.params) && same(s.camera, saved.state.camera), 'load view');
+  check(st, `load view "${saved.name}" restored ${saved.state.dataset}/${saved.state.technique}, params and camera`);
+  await settled(page);
+}
+
+// The two attribute rules of controls.js on a synthetic schema, so they
+// cannot be met by knowing parameter names: an 'attribute' parameter of any
+// name becomes a select, an 'int' named "attribute" stays a slider.
+async function synthetic(page) {
+  const r = await page.evaluate(async () => {
+    const { ParamControls } = await import('/controls.js');
+    const form = document.createElement('form');
+    const sent = [];
+    const pc = new ParamControls(form, (n, v) => sent.push([n, v]));
+    pc.build([
+      { name: 'zz_pick', type: 'attribute', min: -1, max: 31, default: 0, unit: '', description: '' },
+      { name: 'zz_strict', type: 'attribute', min: 0, max: 31, default: 0, unit: '', description: '' },
+      { name: 'attribute', type: 'int', min: -1, max: 31, default: 0, unit: '', description: '' },
+    ], ['p', 'q']);
+    pc.update({ zz_pick: 1, zz_strict: 0, attribute: 3 });
+    const pick = form.querySelector('select[name=zz_pick]');
+    const strict = form.querySelector('select[name=zz_strict]');
+    const opts = (s) => (s ? [...s.options].map((o) => o.textContent) : null);
+    const shown = pick && pick.value;
+    pick.value = '-1';
+    pick.dispatchEvent(new Event('change'));
+    strict.value = '1';
+    strict.dispatchEvent(new Event('change'));
+    return { pick: opts(pick), strict: opts(strict), shown, sent,
+      intIsSlider: !!form.querySelector('input[type=range][name=attribute]') };
+  });
+  check(same(r.pick, ['none', 'p', 'q']) && r.shown === '1', `synthetic attribute select ${JSON.stringify(r)}`);
+  check(same(r.strict, ['p', 'q']), `an attribute with min 0 has no "none" ${JSON.stringify(r.strict)}`);
+  check(same(r.sent, [['zz_pick', -1], ['zz_strict', 1]]), `attribute selects send indices ${JSON.stringify(r.sent)}`);
+  check(r.intIsSlider, 'an int parameter named "attribute" is a slider');
+}
+
+// Control hand-over: the viewer asks, the controller grants, the server says
+// so, the new controller's change reaches the server, the old one is a viewer.
+async function handOver(page, page2, obs, sess) {
+  const id2 = await page2.evaluate(() => window.sightline.clientId);
+  check(await page2.isVisible('#control') && (await page2.isDisabled('#technique')), 'viewer: request button, pickers disabled');
+  await page2.click('#control');
+  const grant = page.locator('#request-list button', { hasText: `client ${id2}` });
+  await grant.waitFor({ timeout: T });
+  await grant.click();
+  check(await serverStateWhere(obs, sess, (s) => s.controller === id2, 'grant'), `controller is client ${id2} on the server`);
+  await page2.waitForFunction(() => document.getElementById('role').textContent === 'controller', null, { timeout: T });
+  await page.waitForFunction(() => document.getElementById('role').textContent === 'viewer', null, { timeout: T });
+  check(await page.isDisabled('#params input[type=checkbox]') && (await page.isDisabled('#dataset')),
+    'the old controller\'s controls are disabled');
+  const schema = await page2.evaluate(() => window.sightline.techniques.find((t) => t.name === window.sightline.state.technique).params);
+  const bool = schema.find((d) => d.type === 'bool');
+  const before = (await observeOnce(obs, sess.session, sess.token)).params[bool.name];
+  await page2.click(`#params input[type=checkbox][name=${bool.name}]`);
+  check(await serverStateWhere(obs, sess, (s) => s.params[bool.name] === !before, 'new controller'),
+    `the new controller's ${bool.name} = ${!before} reached the server`);
+  await page.waitForFunction(([n, v]) => window.sightline.state.params[n] === v, [bool.name, !before], { timeout: T });
+  check(true, 'the old controller (now a viewer) sees the change');
+}
+
 async function main() {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'sl-browser-test-'));
   let { proc, port } = await startServer(dir);
@@ -72,8 +290,7 @@ async function main() {
     args: ['--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update',
       '--no-first-run'],
   });
-  const artifacts = path.join(SRC, 'build');
-  fs.mkdirSync(artifacts, { recursive: true });
+  fs.mkdirSync(ARTIFACTS, { recursive: true });
   try {
     const page = await browser.newPage({ viewport: { width: 900, height: 600 } });
     page.on('pageerror', (e) => { failed++; console.error(`page error: ${e.message}`); });
@@ -193,21 +410,20 @@ async function main() {
       const id = await page.evaluate(() => window.sightline.lastFrame.frameId);
       check(id > before.id, `parameter change rendered a new frame (${before.id} -> ${id})`);
     }
-    await page.screenshot({ path: path.join(artifacts, 'browser-test-controller.png') });
+    await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-controller.png') });
 
-    // 3a. The attribute parameter names the dataset's attributes once it is loaded.
+    // 3a. Every 'attribute' parameter is a select of the dataset's attributes once they are known.
     await page.waitForFunction(() => document.querySelectorAll('#params select[name=attribute] option').length > 1,
       null, { timeout: T }).catch(() => {});
     const attrs = await page.$$eval('#params select[name=attribute] option', (os) => os.map((o) => o.textContent));
     check(attrs[0] === 'none' && attrs.length > 1, `attribute control lists the dataset's attributes ${JSON.stringify(attrs)}`);
-    // radius_attribute (techniques with per-vertex radii) is a select of the same names.
-    const radiusAttrs = await page.$$eval('#params select[name=radius_attribute] option', (os) => os.map((o) => o.textContent));
-    const [tech, schemaHasRadiusAttr] = await page.evaluate(() => {
+    const typed = await page.evaluate(() => {
       const t = window.sightline.techniques.find((x) => x.name === window.sightline.state.technique);
-      return [t.name, t.params.some((p) => p.name === 'radius_attribute')];
+      return t.params.filter((p) => p.type === 'attribute').map((p) => p.name);
     });
-    check(schemaHasRadiusAttr ? JSON.stringify(radiusAttrs) === JSON.stringify(attrs) : radiusAttrs.length === 0,
-      `${tech}: radius_attribute control (in schema: ${schemaHasRadiusAttr}) lists ${JSON.stringify(radiusAttrs)}`);
+    const selects = await page.$$eval('#params select[data-type=attribute]', (xs) => xs.map((x) => x.name));
+    check(typed.length >= 2 && same(typed, selects), `attribute selects ${JSON.stringify(selects)} = schema's ${JSON.stringify(typed)}`);
+    await synthetic(page);
 
     // 3b. Snapshot button downloads a PNG; a named view is saved and listed.
     const [download] = await Promise.all([page.waitForEvent('download', { timeout: T }), page.click('#snapshot')]);
@@ -216,10 +432,18 @@ async function main() {
     const magic = fs.readFileSync(snapPath).subarray(0, 8).toString('hex');
     check(magic === '89504e470d0a1a0a' && download.suggestedFilename().endsWith('.png'), `snapshot is a PNG (${magic})`);
     await page.fill('#view-name', 'browser view');
+    const link0 = await page.inputValue('#share-link');
+    const sess = { session: link0.match(/session=([0-9a-f]+)/)[1], token: link0.match(/token=([0-9a-f]+)/)[1] };
+    const obs = await browser.newPage();
+    await obs.goto(`http://127.0.0.1:${port}/healthz`);
+    const saved = { name: 'browser view', state: await observeOnce(obs, sess.session, sess.token) };
     await page.click('#save-view');
     await page.waitForFunction(() => [...document.querySelectorAll('#views option')].some((o) => o.value === 'browser view'),
       null, { timeout: T });
     check(true, 'saved view is listed');
+
+    // 3c. Every control kind, each value read back from the server.
+    await driveControls(page, obs, sess, saved);
 
     // 4. The share link opens the same session in a second page: same frame, same pixels.
     const link = await page.inputValue('#share-link');
@@ -239,8 +463,12 @@ async function main() {
       const v2 = await page2.evaluate((n) => window.sightline.state.params[n], changed);
       check(v1 === v2, `viewer sees the changed parameter (${v1} vs ${v2})`);
     }
-    await page2.screenshot({ path: path.join(artifacts, 'browser-test-viewer.png') });
+    await page2.screenshot({ path: path.join(ARTIFACTS, 'browser-test-viewer.png') });
+
+    // 4a. Control moves to the second page on request and grant.
+    await handOver(page, page2, obs, sess);
     await page2.close();
+    await obs.close();
 
     // 5. Server restart: a clear disconnect message, then automatic reconnect and frames again.
     const framesBefore = await page.evaluate(() => window.sightline.frames);

@@ -16,6 +16,7 @@
  * names its field; a passed camera check passes again; a frame header that
  * reads matches the input's size. Single-threaded; test-only.
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,8 +95,10 @@ static void check_params(const cJSON *patch)
             int k_count = d->type == SL_PARAM_VEC3 ? 3 : 1;
             for (int k = 0; k < k_count; k++) {
                 double v = p.value[i][k];
-                if ((d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3) &&
-                    !(v >= d->min && v <= d->max))
+                if ((d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3 ||
+                     d->type == SL_PARAM_ATTRIBUTE) && !(v >= d->min && v <= d->max))
+                    abort();
+                if (d->type == SL_PARAM_ATTRIBUTE && v != floor(v))
                     abort();
                 if (d->type == SL_PARAM_BOOL && v != 0.0 && v != 1.0)
                     abort();

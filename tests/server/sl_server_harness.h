@@ -8,7 +8,8 @@
  * harness_stop sends SIGTERM and returns the exit status, so a leak (ASan)
  * or a crash at shutdown fails the test. tclient wraps sl_wsclient: it
  * parses text messages into cJSON, records every binary frame (header +
- * payload copy) and acks frames when auto_ack is set. Loopback only.
+ * payload copy) and acks frames when auto_ack is set. harness_cli_render
+ * renders a reference with sightline-render. Loopback only.
  * One thread per tclient; header-only (static functions) for tests and bench.
  */
 #ifndef SL_SERVER_HARNESS_H
@@ -418,6 +419,41 @@ static __attribute__((unused)) double harness_mean_diff(const sl_image *a, const
     for (size_t i = 0; i < n; i++)
         sum += fabs((double)a->rgba[i] - (double)b->rgba[i]);
     return sum / (double)n;
+}
+
+/* Renders scene_json (a scene document, proto/scene.md) with
+ * $SIGHTLINE_BINARY_DIR/bin/sightline-render --samples 1 (the server
+ * renders without MSAA) into h->dir/name.png and reads it back. Returns 0
+ * with *out filled (free with sl_image_deinit), or -1 (the reason on stderr). */
+static __attribute__((unused)) int harness_cli_render(const harness *h, const char *scene_json, const char *name,
+                                                      sl_image *out)
+{
+    char scene_path[400], png_path[400], exe[1024];
+    snprintf(scene_path, sizeof scene_path, "%s/%s.json", h->dir, name);
+    snprintf(png_path, sizeof png_path, "%s/%s.png", h->dir, name);
+    FILE *f = fopen(scene_path, "w");
+    if (!f || fputs(scene_json, f) < 0) {
+        if (f)
+            fclose(f);
+        fprintf(stderr, "harness: cannot write %s\n", scene_path);
+        return -1;
+    }
+    if (fclose(f) != 0)
+        return -1;
+    const char *bin = getenv("SIGHTLINE_BINARY_DIR");
+    snprintf(exe, sizeof exe, "%s/bin/sightline-render", bin ? bin : "build");
+    char *argv[] = {exe, "--scene", scene_path, "--out", png_path, "--samples", "1", NULL};
+    int rc = harness_run_wait(argv);
+    if (rc != 0) {
+        fprintf(stderr, "harness: sightline-render %s exited %d\n", scene_path, rc);
+        return -1;
+    }
+    sl_err err = {0};
+    if (sl_png_read(png_path, out, &err) != SL_OK) {
+        fprintf(stderr, "harness: %s: %s\n", png_path, err.message);
+        return -1;
+    }
+    return 0;
 }
 
 /* GET path from 127.0.0.1:port with the given Host header (NULL:

@@ -9,7 +9,10 @@
  * a message that names the parameter and the allowed range (or choices),
  * and a failed patch changes nothing. The schema JSON is checked field by
  * field against the C tables. A private schema covers every type and every
- * invalidation level, and the typed getters. No GL.
+ * invalidation level, and the typed getters. Attribute indices: the schema
+ * range ("none" = -1 only where min is -1), JSON numbers only, and the
+ * dataset check (sl_params_check_attributes) word for word; every technique
+ * declares `attribute` and `radius_attribute` with that type. No GL.
  */
 #include <cjson/cJSON.h>
 #include <float.h>
@@ -32,7 +35,8 @@ static int choice_count(const sl_param_def *d)
 
 static int is_numeric(const sl_param_def *d)
 {
-    return d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3;
+    return d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3 ||
+           d->type == SL_PARAM_ATTRIBUTE;
 }
 
 static int same_values(const sl_params *a, const sl_params *b)
@@ -52,6 +56,7 @@ static int names_range(const char *msg, const sl_param_def *d)
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
     case SL_PARAM_VEC3:
+    case SL_PARAM_ATTRIBUTE:
         snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
         return strstr(msg, range) != NULL;
     case SL_PARAM_BOOL:
@@ -131,6 +136,7 @@ static cJSON *other_value(const sl_param_def *d, double out[3])
         out[0] = d->def[0] < d->max ? d->def[0] + 0.5 * (d->max - d->def[0]) : 0.5 * (d->min + d->def[0]);
         return d->type == SL_PARAM_FLOAT ? cJSON_CreateNumber(out[0]) : cJSON_CreateDoubleArray(out, 3);
     case SL_PARAM_INT:
+    case SL_PARAM_ATTRIBUTE:
         if (d->min == d->max)
             return NULL;
         out[0] = d->def[0] < d->max ? d->def[0] + 1 : d->def[0] - 1;
@@ -178,7 +184,8 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
     int def_ok = 0;
     switch (d->type) {
     case SL_PARAM_FLOAT:
-    case SL_PARAM_INT: def_ok = cJSON_IsNumber(def) && def->valuedouble == d->def[0]; break;
+    case SL_PARAM_INT:
+    case SL_PARAM_ATTRIBUTE: def_ok = cJSON_IsNumber(def) && def->valuedouble == d->def[0]; break;
     case SL_PARAM_BOOL: def_ok = cJSON_IsBool(def) && cJSON_IsTrue(def) == (d->def[0] != 0.0); break;
     case SL_PARAM_ENUM: {
         def_ok = cJSON_IsString(def) && strcmp(def->valuestring, d->choices[(int)d->def[0]]) == 0;
@@ -219,6 +226,10 @@ static void test_parameter(const sl_technique *t, int i)
             in_range &= d->def[k] >= d->min && d->def[k] <= d->max;
         in_range &= isfinite(d->min) && isfinite(d->max) && d->min <= d->max;
         break;
+    case SL_PARAM_ATTRIBUTE:
+        /* min -1 (-1 = none) or 0; an index, so max is a small integer. */
+        in_range &= (d->min == -1.0 || d->min == 0.0) && d->max == floor(d->max) && d->max >= 0 && d->max < 1024;
+        /* fall through */
     case SL_PARAM_INT:
         in_range &= d->def[0] == floor(d->def[0]);
         /* fall through */
@@ -272,14 +283,14 @@ static void test_parameter(const sl_technique *t, int i)
             SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, v, d->type == SL_PARAM_VEC3 ? 3 : 1, &err) == SL_OK,
                          "%s.%s = %g (an end of its range): %s", t->name, d->name, ends[e], err.message);
         }
-        double step = d->type == SL_PARAM_INT ? 1.0 : 0.0;
+        double step = d->type == SL_PARAM_INT || d->type == SL_PARAM_ATTRIBUTE ? 1.0 : 0.0;
         double below = step ? d->min - 1 : nextafter(d->min, -INFINITY);
         double above = step ? d->max + 1 : nextafter(d->max, INFINITY);
         expect_refused_numbers(&base, d, below, "below min");
         expect_refused_numbers(&base, d, above, "above max");
         expect_refused_numbers(&base, d, d->min - 1e6 * (1 + fabs(d->min)), "far below min");
     }
-    if (d->type == SL_PARAM_INT && d->min < d->max)
+    if ((d->type == SL_PARAM_INT || d->type == SL_PARAM_ATTRIBUTE) && d->min < d->max)
         expect_refused_numbers(&base, d, d->min + 0.5, "not an integer");
     if (d->type == SL_PARAM_ENUM) {
         /* Past the last index, and no choice's name (numeric names are
@@ -313,6 +324,7 @@ static void test_parameter(const sl_technique *t, int i)
     switch (d->type) {
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
+    case SL_PARAM_ATTRIBUTE:
         expect_refused(&base, d, cJSON_CreateString("1"), "a string");
         expect_refused(&base, d, cJSON_CreateTrue(), "a bool");
         expect_refused(&base, d, cJSON_CreateDoubleArray(d->def, 1), "an array");
@@ -433,6 +445,8 @@ static const sl_param_def test_schema[] = {
     {"b", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "a bool", SL_INVALIDATE_PREPARED},
     {"e", SL_PARAM_ENUM, 0, 0, {1}, fruit, "", "an enum", SL_INVALIDATE_DATASET},
     {"v", SL_PARAM_VEC3, -1, 1, {0.1, 0.2, 0.3}, NULL, "rgb", "a vec3", SL_INVALIDATE_FRAME},
+    {"a", SL_PARAM_ATTRIBUTE, -1, 3, {0}, NULL, "", "an attribute, -1 = none", SL_INVALIDATE_FRAME},
+    {"ra", SL_PARAM_ATTRIBUTE, 0, 3, {1}, NULL, "", "an attribute without none", SL_INVALIDATE_PREPARED},
 };
 enum { TEST_COUNT = (int)(sizeof test_schema / sizeof test_schema[0]) };
 static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL, NULL};
@@ -507,6 +521,7 @@ static void test_private_schema(void)
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_BOOL), "bool") == 0);
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_ENUM), "enum") == 0);
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_VEC3), "vec3") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_ATTRIBUTE), "attribute") == 0);
 
     /* A concrete message, word for word where it matters. */
     sl_params_init(&p, test_schema, TEST_COUNT);
@@ -516,9 +531,98 @@ static void test_private_schema(void)
     SL_CHECK(err.status == SL_ERR_INVALID);
 }
 
+/* Attribute indices: the schema range, then the dataset's count
+ * (sl_params_check_attributes), with "none" only where min is -1. */
+static void test_attributes(void)
+{
+    sl_params p;
+    sl_params_init(&p, test_schema, TEST_COUNT);
+    sl_err err = {0};
+    SL_CHECK(sl_params_attribute(&p, "a") == 0 && sl_params_attribute(&p, "ra") == 1);
+    /* Schema range: -1 is "none" for a, out of range for ra; fractions and past max are refused. */
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){-1}, 1, &err) == SL_OK && sl_params_attribute(&p, "a") == -1);
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){-2}, 1, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "'a'") && strstr(err.message, "[-1, 3]") && strstr(err.message, "-1 = none") &&
+                 strstr(err.message, "-2"), "%s", err.message);
+    SL_CHECK(sl_params_set_numbers(&p, "ra", (double[]){-1}, 1, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strstr(err.message, "'ra'") && strstr(err.message, "[0, 3]") && !strstr(err.message, "none"), "%s",
+                 err.message);
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){1.5}, 1, &err) == SL_ERR_INVALID && strstr(err.message, "'a'"));
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){4}, 1, &err) == SL_ERR_INVALID && strstr(err.message, "'a'"));
+    SL_CHECK(sl_params_attribute(&p, "a") == -1 && sl_params_attribute(&p, "ra") == 1);
+    /* JSON takes an index, not a name, nor a bool or null. */
+    const char *bad[] = {"{\"a\": \"speed\"}", "{\"a\": true}", "{\"a\": null}", "{\"a\": [1]}", "{\"a\": 0.5}"};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        cJSON *patch = cJSON_Parse(bad[k]);
+        SL_CHECK_MSG(sl_params_apply_json(&p, patch, &err) == SL_ERR_INVALID && strstr(err.message, "'a'"), "%s: %s",
+                     bad[k], err.message);
+        cJSON_Delete(patch);
+    }
+    SL_CHECK(sl_params_attribute(&p, "a") == -1);
+    cJSON *patch = cJSON_Parse("{\"a\": 2, \"ra\": 0}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && sl_params_attribute(&p, "a") == 2 &&
+             sl_params_attribute(&p, "ra") == 0);
+    cJSON_Delete(patch);
+    cJSON *json = sl_params_to_json(&p);
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(json, "a");
+    SL_CHECK(cJSON_IsNumber(a) && a->valuedouble == 2);
+    cJSON_Delete(json);
+    cJSON *schema = sl_params_schema_json(test_schema, TEST_COUNT);
+    const cJSON *def = cJSON_GetArrayItem(schema, 5);
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(def, "type");
+    const cJSON *mn = cJSON_GetObjectItemCaseSensitive(def, "min");
+    SL_CHECK(cJSON_IsString(type) && strcmp(type->valuestring, "attribute") == 0 && cJSON_IsNumber(mn) &&
+             mn->valuedouble == -1 && !cJSON_GetObjectItemCaseSensitive(def, "choices"));
+    cJSON_Delete(schema);
+
+    /* Against a dataset with 3 attributes: a = 2, ra = 0 exist. */
+    SL_CHECK_MSG(sl_params_check_attributes(&p, 3, &err) == SL_OK, "%s", err.message);
+    /* With 2, a = 2 does not: the message names it, its value and the valid range. */
+    SL_CHECK(sl_params_check_attributes(&p, 2, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strcmp(err.message, "params.a = 2: the dataset has 2 per-vertex attributes (valid: -1 .. 1)") == 0,
+                 "%s", err.message);
+    /* -1 (none) fits every dataset, even one without attributes. */
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){-1}, 1, &err) == SL_OK);
+    SL_CHECK(sl_params_check_attributes(&p, 2, &err) == SL_OK);
+    SL_CHECK(sl_params_check_attributes(&p, 1, &err) == SL_OK); /* ra = 0 */
+    SL_CHECK(sl_params_check_attributes(&p, 0, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strcmp(err.message, "params.ra = 0: the dataset has 0 per-vertex attributes (valid: 0 .. -1)") == 0,
+                 "%s", err.message);
+    /* A default is accepted on any dataset ("the first, if any"): a = 0 and ra = 1 with no attributes. */
+    sl_params_init(&p, test_schema, TEST_COUNT);
+    SL_CHECK_MSG(sl_params_check_attributes(&p, 0, &err) == SL_OK, "%s", err.message);
+    SL_CHECK(sl_params_set_numbers(&p, "a", (double[]){1}, 1, &err) == SL_OK);
+    SL_CHECK(sl_params_check_attributes(&p, 1, &err) == SL_ERR_INVALID);
+    SL_CHECK_MSG(strcmp(err.message, "params.a = 1: the dataset has 1 per-vertex attribute (valid: -1 .. 0)") == 0,
+                 "%s", err.message);
+    SL_CHECK(sl_params_check_attributes(&p, 2, &err) == SL_OK);
+    /* Other parameters' values are never read as indices (a float at -1e30 is no int). */
+    const sl_technique *t = sl_technique_find("tubes_mesh");
+    SL_CHECK(t != NULL);
+    if (t) {
+        sl_params_init(&p, t->params, t->param_count);
+        SL_CHECK(sl_params_set_numbers(&p, "scalar_min", (double[]){-1e30}, 1, &err) == SL_OK);
+        SL_CHECK_MSG(sl_params_check_attributes(&p, 1, &err) == SL_OK, "%s", err.message);
+    }
+}
+
 /* The technique schemas' shared names: a few declared facts the rest of the code relies on. */
 static void test_known_parameters(void)
 {
+    /* Every line technique's attribute indices are typed as such, so the page
+     * builds their selects from the schema alone. */
+    int n = 0, attribute_params = 0;
+    const sl_technique *const *list = sl_technique_list(&n);
+    for (int ti = 0; ti < n; ti++)
+        for (int i = 0; i < list[ti]->param_count; i++) {
+            const sl_param_def *d = &list[ti]->params[i];
+            if (strcmp(d->name, "attribute") == 0 || strcmp(d->name, "radius_attribute") == 0) {
+                SL_CHECK_MSG(d->type == SL_PARAM_ATTRIBUTE && d->min == -1, "%s.%s is a %s", list[ti]->name, d->name,
+                             sl_param_type_name(d->type));
+                attribute_params++;
+            }
+        }
+    SL_CHECK_MSG(attribute_params >= 4, "%d attribute parameters in the registry", attribute_params);
     const sl_technique *t = sl_technique_find("tubes_mesh");
     SL_CHECK(t != NULL);
     if (!t)
@@ -578,6 +682,7 @@ int main(void)
     test_techniques();
     test_private_schema();
     test_numeric_enum();
+    test_attributes();
     test_known_parameters();
     SL_TEST_END();
 }

@@ -99,7 +99,8 @@ static int move_param(sl_params *p, int i, sl_err *err)
         break;
     }
     case SL_PARAM_INT:
-        /* Down first: index parameters (attribute 0 -> -1) stay valid on
+    case SL_PARAM_ATTRIBUTE:
+        /* Down first: attribute indices (attribute 0 -> -1) stay valid on
          * a dataset with one attribute. */
         v[0] = v[0] - 1.0 >= d->min ? v[0] - 1.0 : v[0] + 1.0;
         break;
