@@ -13,7 +13,7 @@
  *    Then the same lines and cameras through the peers: VTK's tube filter and
  *    Embree round curves (sl_bench_peer_*), as ratios to ours.
  * 2. Error against time: every root method x iterations 2..12, 16, 20, 24, 32,
- *    depth error against the CPU reference (tests/render/tubes/tubes_reference.c)
+ *    depth error against the CPU reference (tests/support/tubes_reference.c)
  *    at 128x128, and the frame ms of the same scene at the benchmark size.
  * 3. How far the quadratic pair lies from the true cubic Hermite sweep
  *    (both by the reference) on smaller versions of the five datasets.
@@ -37,7 +37,8 @@
 
 /* The reference intersector is test code kept apart from the renderer library
  * (it must share nothing with the shader path); compiled into this program. */
-#include "../tests/render/tubes/tubes_reference.c"
+#include "tubes_reference.h"
+#include "tubes_reference_input.h"
 
 typedef struct bench_dataset {
     const char *name;       /* the paper's dataset it stands in for */
@@ -222,18 +223,21 @@ static error_stats compare(const float *gpu, const float *ref, const float *rad,
 static sl_status reference_of(const sl_dataset *ds, const sl_view *view, const sl_params *params, int cubic,
                               float *ref, float *rad, int *seg, sl_err *err)
 {
-    sl_tubes_nodes nodes;
-    sl_status st = sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(params, "tangents"), -1,
-                                        &nodes, err);
-    if (st != SL_OK)
-        return st;
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
-    sl_tubes_nodes_set_radii(&ds->lines, style.radius_attribute, &nodes);
-    tubes_ref_desc rd = {.view = view, .origin = ds->origin, .nodes = &nodes, .radius = style.radius,
-                         .radius_scale = style.radius_scale, .cubic = cubic};
+    const char *mode = sl_params_choice_name(params, "tangents");
+    tubes_ref_tangents tangents = strcmp(mode, "catmull_rom") == 0  ? TUBES_REF_TANGENTS_CATMULL_ROM
+                                  : strcmp(mode, "data_exact") == 0 ? TUBES_REF_TANGENTS_DATA
+                                                                    : TUBES_REF_TANGENTS_AUTO;
+    tubes_ref_input in;
+    char msg[256];
+    if (tubes_ref_input_lines(ds, tangents, style.radius_attribute, style.radius, style.radius_scale, &in, msg,
+                              sizeof msg) != 0)
+        return sl_err_set(err, SL_ERR_NOMEM, "reference input: %s", msg);
+    tubes_ref_desc rd = {.view = view, .origin = in.origin, .segments = in.segments, .segment_count = in.count,
+                         .cubic = cubic};
     tubes_ref_render(&rd, ref, rad, seg);
-    sl_tubes_nodes_deinit(&nodes);
+    tubes_ref_input_free(&in);
     return SL_OK;
 }
 
@@ -280,7 +284,7 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
     printf("\n## Depth error against the reference, by root method and iterations\n\n");
     printf("bundle, %zu segments, radius 1/60 of the bounding radius, %dx%d, close view; error in units of the local "
            "tube radius; \"away\" excludes reference silhouettes (3x3 coverage change or depth jump > radius; "
-           "tests/render/tubes/tubes_reference.c tubes_ref_silhouette).\n\n", segs, w, h);
+           "tests/support/tubes_reference.c tubes_ref_silhouette).\n\n", segs, w, h);
     printf("| method | iterations | max error (away) | max error (all) | mean error | pixels (away / both hit) | "
            "coverage mismatch | frame ms %dx%d | frame ms %dx%d |\n", w, h, one.width, one.height);
     printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");

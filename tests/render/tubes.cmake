@@ -1,5 +1,7 @@
 # GPU tests of the `tubes` technique (renderer/tubes/): depth against the CPU
-# double-precision reference (tests/render/tubes/tubes_reference.c) on random
+# double-precision reference (tests/support/tubes_reference.c, its input built
+# from the scene's JSON or polylines by tests/support/tubes_reference_input.c,
+# not by the renderer's node builder) on random
 # and degenerate Hermite segment sets, through the pipeline (tubes-check) and
 # through `sightline-render --depth` + `sightline-diff`; golden images.
 # Scenes and goldens live in tests/render/tubes/; chained commands run through
@@ -14,16 +16,14 @@
 set(TUBES_DIR ${CMAKE_CURRENT_SOURCE_DIR}/tubes)
 set(TUBES_OUT ${SL_RENDER_OUT}/tubes)
 file(MAKE_DIRECTORY ${TUBES_OUT})
-add_executable(tubes-check ${TUBES_DIR}/tubes_check.c ${TUBES_DIR}/tubes_reference.c)
-target_include_directories(tubes-check PRIVATE ${TUBES_DIR} ${CMAKE_SOURCE_DIR}/proto)
-target_link_libraries(tubes-check PRIVATE sightline_proto sightline_renderer)
+add_executable(tubes-check ${TUBES_DIR}/tubes_check.c)
+target_include_directories(tubes-check PRIVATE ${CMAKE_SOURCE_DIR}/proto)
+target_link_libraries(tubes-check PRIVATE sightline_test_support sightline_proto sightline_renderer)
 set_target_properties(tubes-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
-# The brute-force reference is slow unoptimized: always optimize it.
-set_source_files_properties(${TUBES_DIR}/tubes_reference.c PROPERTIES COMPILE_OPTIONS "-O2")
 
-add_executable(test_tubes_reference ${TUBES_DIR}/test_tubes_reference.c ${TUBES_DIR}/tubes_reference.c)
-target_include_directories(test_tubes_reference PRIVATE ${TUBES_DIR} ${CMAKE_SOURCE_DIR}/tests/unit)
-target_link_libraries(test_tubes_reference PRIVATE sightline_proto sightline_renderer)
+add_executable(test_tubes_reference ${TUBES_DIR}/test_tubes_reference.c)
+target_include_directories(test_tubes_reference PRIVATE ${CMAKE_SOURCE_DIR}/tests/unit)
+target_link_libraries(test_tubes_reference PRIVATE sightline_test_support sightline_proto sightline_renderer)
 set_target_properties(test_tubes_reference PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
 add_test(NAME unit.test_tubes_reference COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_tubes_reference>
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})

@@ -48,8 +48,8 @@
 #include "pipeline/sl_pipeline.h"
 #include "sl_params_json.h"
 #include "sl_scene.h"
-#include "tubes/tubes_nodes.h"
 #include "tubes_reference.h"
+#include "tubes_reference_input.h"
 
 #define MAX_SETS 32
 
@@ -179,6 +179,60 @@ static cJSON *random_folds(int n, unsigned long long seed, char axis, double til
         cJSON_AddItemToArray(segs, cJSON_CreateIntArray(pair, 2));
     }
     return root;
+}
+
+static char *read_text(const char *path);
+
+/* The scene's explicit Hermite JSON (inline, or a .json file holding it), parsed
+ * for the reference; NULL when the dataset is anything else. Caller deletes. */
+static cJSON *hermite_root(const sl_scene *scene, const char *data_dir)
+{
+    if (tubes_ref_is_hermite_json(scene->dataset))
+        return cJSON_Duplicate(scene->dataset, 1);
+    if (!cJSON_IsString(scene->dataset))
+        return NULL;
+    const char *name = scene->dataset->valuestring;
+    size_t n = strlen(name);
+    if (n <= 5 || strcmp(name + n - 5, ".json") != 0)
+        return NULL;
+    char path[4096];
+    snprintf(path, sizeof path, "%s%s%s", name[0] != '/' && data_dir ? data_dir : "",
+             name[0] != '/' && data_dir ? "/" : "", name);
+    char *text = read_text(path);
+    cJSON *root = text ? cJSON_Parse(text) : NULL;
+    free(text);
+    if (!tubes_ref_is_hermite_json(root)) {
+        cJSON_Delete(root);
+        return NULL;
+    }
+    return root;
+}
+
+/* The reference's own segments: from the scene's Hermite JSON where it has
+ * one (unless Catmull-Rom tangents are asked for, which only the line set
+ * has), else from the loaded polylines — never through tubes_nodes.c. */
+static int reference_input(const sl_scene *scene, const char *data_dir, const sl_dataset *ds, const sl_params *params,
+                           const sl_line_style *style, tubes_ref_input *in, char *msg, size_t size)
+{
+    const char *mode = sl_params_choice_name(params, "tangents");
+    tubes_ref_tangents tangents = strcmp(mode, "catmull_rom") == 0  ? TUBES_REF_TANGENTS_CATMULL_ROM
+                                  : strcmp(mode, "data_exact") == 0 ? TUBES_REF_TANGENTS_DATA
+                                                                    : TUBES_REF_TANGENTS_AUTO;
+    cJSON *root = tangents != TUBES_REF_TANGENTS_CATMULL_ROM ? hermite_root(scene, data_dir) : NULL;
+    int rc;
+    if (root) {
+        int ra = style->radius_attribute;
+        int from_scalar = ra >= 0 && strcmp(ds->lines.attributes[ra].name, "scalar") == 0;
+        if (ra >= 0 && !from_scalar) {
+            snprintf(msg, size, "radius_attribute %d of Hermite JSON must be the colour scalar", ra);
+            rc = -1;
+        } else
+            rc = tubes_ref_input_hermite_json(root, from_scalar, style->radius, style->radius_scale, in, msg, size);
+        cJSON_Delete(root);
+        return rc;
+    }
+    return tubes_ref_input_lines(ds, tangents, style->radius_attribute, style->radius, style->radius_scale, in, msg,
+                                 size);
 }
 
 /* Explicit Hermite data inline ({"nodes":..}) or in a .json file; else the scene's own loader. */
@@ -405,20 +459,20 @@ int main(int argc, char **argv)
     size_t np = (size_t)w * (size_t)h;
     float *ref = calloc(np, sizeof *ref), *rad = calloc(np, sizeof *rad), *gpu = calloc(np, sizeof *gpu);
     int *seg = calloc(np, sizeof *seg);
-    sl_tubes_nodes nodes = {0};
+    tubes_ref_input input = {0};
+    char input_msg[256] = "";
     sl_line_style style;
     sl_line_style_read(&params, ds, &style);
     int rc = 0;
     if (!ref || !rad || !gpu || !seg ||
         sl_line_style_check(&params, ds, &err) != SL_OK ||
-        sl_tubes_nodes_build(&ds->lines, (sl_tubes_tangents)sl_params_choice(&params, "tangents"), -1, &nodes, &err) != SL_OK) {
-        fprintf(stderr, "tubes-check: %s\n", err.message[0] ? err.message : "out of memory");
+        reference_input(&scene, data_dir, ds, &params, &style, &input, input_msg, sizeof input_msg) != 0) {
+        fprintf(stderr, "tubes-check: %s\n", err.message[0] ? err.message : input_msg[0] ? input_msg : "out of memory");
         rc = 2;
         goto done;
     }
-    sl_tubes_nodes_set_radii(&ds->lines, style.radius_attribute, &nodes);
-    tubes_ref_desc rd = {.view = &view, .origin = ds->origin, .nodes = &nodes, .radius = style.radius,
-                         .radius_scale = style.radius_scale, .cubic = 0, .samples = o.ref_samples};
+    tubes_ref_desc rd = {.view = &view, .origin = input.origin, .segments = input.segments,
+                         .segment_count = input.count, .cubic = 0, .samples = o.ref_samples};
     double t0 = sl_clock_ms();
     tubes_ref_render(&rd, ref, rad, seg);
     double ref_ms = sl_clock_ms() - t0;
@@ -563,7 +617,7 @@ int main(int argc, char **argv)
     }
     free(cubic);
 done:
-    sl_tubes_nodes_deinit(&nodes);
+    tubes_ref_input_free(&input);
     free(ref);
     free(rad);
     free(gpu);

@@ -161,21 +161,11 @@ static int piece_samples(const tubes_ref_desc *desc, const sl_vec3 *cp, int n, c
 
 static void make_pieces(const tubes_ref_desc *desc, piece *pcs, size_t *count)
 {
-    const sl_tubes_nodes *nd = desc->nodes;
     size_t k = 0;
-    for (size_t s = 0; s < nd->segment_count; s++) {
-        const float *a = nd->geometry + (size_t)nd->segments[2 * s] * SL_TUBES_NODE_FLOATS;
-        const float *b = nd->geometry + (size_t)nd->segments[2 * s + 1] * SL_TUBES_NODE_FLOATS;
-        sl_vec3 pa = sl_v3(a[0], a[1], a[2]), ta = sl_v3(a[4], a[5], a[6]);
-        sl_vec3 pb = sl_v3(b[0], b[1], b[2]), tb = sl_v3(b[4], b[5], b[6]);
-        double ra, dra, rb, drb;
-        if (nd->has_radii) {
-            ra = a[3] * desc->radius_scale; dra = a[7] * desc->radius_scale;
-            rb = b[3] * desc->radius_scale; drb = b[7] * desc->radius_scale;
-        } else {
-            ra = rb = desc->radius;
-            dra = drb = 0.0;
-        }
+    for (size_t s = 0; s < desc->segment_count; s++) {
+        const tubes_ref_segment *g = &desc->segments[s];
+        sl_vec3 pa = g->p0, ta = g->t0, pb = g->p1, tb = g->t1;
+        double ra = g->r0, dra = g->dr0, rb = g->r1, drb = g->dr1;
         piece *q = &pcs[k];
         if (desc->cubic) {
             q->cubic = 1;
@@ -226,7 +216,7 @@ static void make_pieces(const tubes_ref_desc *desc, piece *pcs, size_t *count)
 void tubes_ref_render(const tubes_ref_desc *desc, float *distance, float *radius, int *segment)
 {
     const sl_view *v = desc->view;
-    size_t cap = desc->nodes->segment_count * 2 + 1;
+    size_t cap = desc->segment_count * 2 + 1;
     piece *pcs = malloc(cap * sizeof *pcs);
     int n = desc->samples > 0 ? desc->samples : TUBES_REF_MAX_SAMPLES;
     double *fs = malloc((size_t)(n + 1) * sizeof *fs), *ds = malloc((size_t)(n + 1) * sizeof *ds);

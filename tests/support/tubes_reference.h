@@ -6,20 +6,31 @@
  * (to measure the quadratic approximation). Brute force: dense sampling of
  * the sweep parameter, then golden-section refinement of every local minimum
  * of the entry distance. Shares no code with the shader path (no ray space,
- * no root bracketing, de Casteljau in world coordinates). Single thread.
+ * no root bracketing, de Casteljau in world coordinates). Its input is its
+ * own list of Hermite segments in double (tubes_reference_input.h builds it
+ * from the scene's JSON or the loaded polylines, not through the renderer's
+ * node builder). Single thread.
  */
 #ifndef TUBES_REFERENCE_H
 #define TUBES_REFERENCE_H
 
+#include <stddef.h>
+
 #include "core/sl_camera.h"
-#include "tubes/tubes_nodes.h"
+
+/* One Hermite segment: positions and their derivatives along the segment
+ * parameter t in [0, 1], relative to tubes_ref_desc.origin; the radius and
+ * its derivative (final: any radius scale already applied). */
+typedef struct tubes_ref_segment {
+    sl_vec3 p0, t0, p1, t1;
+    double r0, dr0, r1, dr1;
+} tubes_ref_segment;
 
 typedef struct tubes_ref_desc {
     const sl_view *view;          /* initialised view; eye and rays in world units */
-    sl_vec3 origin;               /* dataset origin (node positions are relative to it) */
-    const sl_tubes_nodes *nodes;
-    double radius;                /* radius where the data gives none */
-    double radius_scale;          /* factor on data radii */
+    sl_vec3 origin;               /* world position the segment coordinates are relative to */
+    const tubes_ref_segment *segments;
+    size_t segment_count;
     int cubic;                    /* 0: two quadratics per segment (the rendered surface); 1: cubic Hermite */
     int samples;                  /* cap on samples of t per piece (0: 8192); a piece takes 16 + 16 x its
                                      control-polygon length / its smallest radius (see piece_samples) */
