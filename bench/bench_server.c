@@ -23,7 +23,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 
-#include "../tests/server/sl_server_harness.h"
+#include "sl_server_harness.h"
 
 typedef struct stat_acc {
     double v[4096];
