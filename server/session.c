@@ -176,6 +176,8 @@ void sl_session_free(sl_session *s)
     free(s->info_bounds);
     free(s->info_counts);
     free(s->info_attrs);
+    for (int i = 0; i < s->progress_count; i++)
+        free(s->progress_text[i]);
     cJSON_Delete(s->bounds);
     free(s);
 }
@@ -258,6 +260,7 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
     st->stream = SL_STREAM_DEFAULTS;
     s->empty_since_ms = sl_clock_ms();
+    s->idle_since_ms = s->empty_since_ms;
     pthread_mutex_lock(&srv->lock);
     s->next = srv->sessions;
     srv->sessions = s;
@@ -279,9 +282,13 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     c->hello_done = 1;
     sl_ws_pending_leave(srv, c);
     /* Render errors from before the join are history, not news for this client. */
+    /* So is a finished round of progress; one in flight is sent from its start. */
     pthread_mutex_lock(&srv->lock);
     srv->client_count++;
     c->error_seq = s->error_seq;
+    s->idle_since_ms = 0;
+    c->progress_round = s->progress_round;
+    c->progress_sent = s->progress_closed ? s->progress_count : 0;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
     sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
@@ -721,6 +728,10 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
         if (s->client_count == 0)
             s->empty_since_ms = sl_clock_ms();
         pthread_mutex_lock(&srv->lock);
+        if (s->client_count == 0) {
+            s->idle_since_ms = s->empty_since_ms; /* the render thread lets go of its prepared state later */
+            pthread_cond_signal(&srv->wake);
+        }
         for (int i = 0; i < s->snap_req_count; i++)
             if (s->snap_req[i] == c->id)
                 s->snap_req[i] = 0;
@@ -807,7 +818,8 @@ void sl_sessions_on_wake(sl_server *srv)
         /* The session's newest render error is sent by write_next (coalesced:
          * a client that is behind gets the latest error once, not a backlog). */
         for (sl_client *c = s->clients; c; c = c->next)
-            if (c->error_seq != s->error_seq)
+            if (c->error_seq != s->error_seq || c->progress_round != s->progress_round ||
+                c->progress_sent < s->progress_count)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
@@ -912,6 +924,19 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
             return write_text_now(c, sl_msg_control_request_text(r->id));
         }
     }
+    /* Progress of the session's current round, each text once and in order;
+     * before errors, so a failed load's `done` precedes its load_failed. */
+    char *progress = NULL;
+    pthread_mutex_lock(&srv->lock);
+    if (c->progress_round != s->progress_round) {
+        c->progress_round = s->progress_round;
+        c->progress_sent = 0;
+    }
+    if (c->progress_sent < s->progress_count)
+        progress = strdup(s->progress_text[c->progress_sent++]);
+    pthread_mutex_unlock(&srv->lock);
+    if (progress)
+        return write_text_now(c, progress);
     char *error = NULL;
     pthread_mutex_lock(&srv->lock);
     if (c->error_seq != s->error_seq) {
