@@ -110,9 +110,10 @@ static sl_session *pick_job(render_ctx *ctx, enum job_kind *kind, double now, do
  * --idle-release seconds (lock held); a scene another session still shows
  * stays. The next render of such a session prepares again (its latest frame
  * stays, so a client that comes back sees it at once). A session busy with
- * a load or a progress round keeps its state until that ends. Returns memory
- * to the system when something was freed; *deadline_ms gets the next
- * release time. */
+ * a load or a progress round keeps its state until that ends. When
+ * something was freed, the lock is let go while the driver's references
+ * are dropped and memory goes back to the system (milliseconds, and no
+ * session pointer is kept across it). *deadline_ms gets the next release. */
 static void release_idle(render_ctx *ctx, double now, double *deadline_ms)
 {
     sl_server *srv = ctx->srv;
@@ -132,8 +133,10 @@ static void release_idle(render_ctx *ctx, double now, double *deadline_ms)
         released++;
     }
     if (released) {
+        pthread_mutex_unlock(&srv->lock);
         sl_gpu_drop_references(); /* else the driver keeps the last-drawn buffers */
         malloc_trim(0);           /* llvmpipe's buffers were malloc'd: give the pages back */
+        pthread_mutex_lock(&srv->lock);
     }
     srv->prepared_scenes = ctx->prepared.count; /* after the memory went back, for /metrics readers */
 }
