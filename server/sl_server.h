@@ -4,9 +4,12 @@
  *   ws.c       lws context, WebSocket protocol, static files (service thread)
  *   session.c  sessions, clients, control, grace period, message handling
  *              (service thread)
- *   render.c   the render thread: owns sl_gpu and one sl_pipeline per session
+ *   render.c   the render thread: owns sl_gpu, the encoder, the prepared scenes
+ *   prepared_cache.c  sl_pipelines shared by sessions on one scene (render thread)
+ *   progress.c the `progress` rounds of long work, posted to sessions (render thread)
  *   interactive_scale.c  the adaptive scale of interactive frames (render thread)
- *   dataset_cache.c  loaded datasets shared by sessions (render thread)
+ *   dataset_cache.c  datasets by source: cached, shared, loaded on its own
+ *              loader threads (any caller; its own lock)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
@@ -14,9 +17,12 @@
  * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
- * render thread owns every GL object. They share only the fields marked
- * "[lock]" below, guarded by sl_server.lock; the render thread waits on
- * sl_server.wake and wakes the service thread with lws_cancel_service.
+ * render thread owns every GL object; the dataset cache's loader threads
+ * only read files and run generators, behind the cache's own lock. The
+ * service and render threads share only the fields marked "[lock]" below,
+ * guarded by sl_server.lock; the render thread waits on sl_server.wake
+ * (a finished load broadcasts it too) and wakes the service thread with
+ * lws_cancel_service. Lock order: sl_server.lock, then the cache's lock.
  * Fields marked "[service]" or "[render]" belong to that thread alone.
  * Nothing is queued without a bound: state is "newest wins", a session keeps
  * one latest frame, a client keeps at most SL_CLIENT_MAX_TEXT replies.
