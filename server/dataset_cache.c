@@ -8,7 +8,8 @@
  * copy, and also one load while it is in flight (same file identity). A
  * finished load enters the cache (the last SL_DATASET_CACHE_SLOTS sources,
  * least recently used out first) and calls desc.on_done on the loader
- * thread, without the cache's lock, so the render thread can be woken.
+ * thread, without the cache's lock, so the render thread can be woken and
+ * the load counted (also one that nobody waits for any more).
  * A failed load is not cached: the next request tries again. A cached file
  * is used only while the file on disk is the one loaded (same inode, size
  * and modification time), so a rewritten file is reloaded and a vanished one
@@ -164,7 +165,7 @@ static void *loader_main(void *arg)
             free_load(l);
         pthread_mutex_unlock(&c->lock);
         if (c->desc.on_done)
-            c->desc.on_done(c->desc.arg);
+            c->desc.on_done(c->desc.arg, rc, ms);
         pthread_mutex_lock(&c->lock);
     }
     pthread_mutex_unlock(&c->lock);

@@ -5,11 +5,11 @@
  * end without one: a failed load, a failed prepare, a newer state that no
  * longer needs it). Each round posts its stages in order — loading (only
  * when a load is waited for), preparing, first_frame, done — at most once
- * each, as ready-made `progress` texts kept on the session under srv->lock
- * (at most SL_PROGRESS_EVENTS per round); session.c sends every client each
- * text of the current round once, in order, and a newer round replaces the
- * older one. A post wakes the service thread at once, so the message leaves
- * before the long step it announces starts.
+ * each, as ready-made `progress` texts numbered per session and kept under
+ * srv->lock in a ring of the newest SL_PROGRESS_RING (two rounds); session.c
+ * sends every client each text once, in order (a client more than a ring
+ * behind skips the oldest). A post wakes the service thread at once, so the
+ * message leaves before the long step it announces starts.
  */
 #include "sl_server.h"
 
@@ -25,15 +25,16 @@ static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double 
                          .technique = r->technique, .fraction = -1, .elapsed_ms = sl_clock_ms() - r->t0_ms,
                          .load_ms = r->load_ms, .prepare_ms = r->prepare_ms, .render_ms = render_ms,
                          .frame = frame, .ok = ok};
-    char *text = sl_msg_progress_text(&m);
+    char *text = sl_msg_progress_text(&m), *old = NULL;
+    if (!text)
+        return;
     pthread_mutex_lock(&srv->lock);
-    if (text && s->progress_count < SL_PROGRESS_EVENTS && s->progress_round == r->id) {
-        s->progress_text[s->progress_count++] = text;
-        s->progress_closed = stage == SL_PROGRESS_DONE;
-        text = NULL;
-    }
+    uint32_t seq = ++s->progress_seq;
+    old = s->progress_text[seq % SL_PROGRESS_RING];
+    s->progress_text[seq % SL_PROGRESS_RING] = text;
+    s->progress_closed = stage == SL_PROGRESS_DONE;
     pthread_mutex_unlock(&srv->lock);
-    free(text);
+    free(old);
     lws_cancel_service(srv->lws);
 }
 
@@ -42,17 +43,11 @@ void sl_progress_begin(sl_server *srv, sl_session *s, const sl_session_state *st
     if (s->round.active)
         sl_progress_end(srv, s, 0, 0, 0);
     sl_progress_round *r = &s->round;
-    char *old[SL_PROGRESS_EVENTS];
     pthread_mutex_lock(&srv->lock);
-    int n = s->progress_count;
-    memcpy(old, s->progress_text, sizeof old);
-    memset(s->progress_text, 0, sizeof s->progress_text);
-    s->progress_count = 0;
+    s->progress_round_start = s->progress_seq;
     s->progress_closed = 0;
     r->id = ++s->progress_round;
     pthread_mutex_unlock(&srv->lock);
-    for (int i = 0; i < n; i++)
-        free(old[i]);
     r->active = 1;
     r->version = st->version;
     memcpy(r->dataset, st->dataset, sizeof r->dataset);

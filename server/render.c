@@ -56,11 +56,15 @@ typedef struct render_ctx {
     sl_prepared_cache prepared;
 } render_ctx;
 
-/* A finished load (loader thread): the render thread picks its sessions up. */
-static void on_load_done(void *arg)
+/* A finished load (loader thread): counted, and the render thread picks its sessions up. */
+static void on_load_done(void *arg, sl_status status, double load_ms)
 {
     sl_server *srv = arg;
     pthread_mutex_lock(&srv->lock);
+    if (status == SL_OK) {
+        srv->metrics.dataset_loads++;
+        sl_histogram_add(&srv->metrics.load_ms, load_ms);
+    }
     pthread_cond_broadcast(&srv->wake);
     pthread_mutex_unlock(&srv->lock);
 }
@@ -257,13 +261,7 @@ static enum scene_status ensure_scene(render_ctx *ctx, sl_session *s, const sl_s
         s->round.load_ms = sl_clock_ms() - s->round.t0_ms;
         if (ls != SL_OK)
             return SCENE_LOAD_FAILED;
-        hit = !s->load_is_new;
-        if (s->load_is_new) {
-            pthread_mutex_lock(&ctx->srv->lock);
-            ctx->srv->metrics.dataset_loads++;
-            sl_histogram_add(&ctx->srv->metrics.load_ms, ms);
-            pthread_mutex_unlock(&ctx->srv->lock);
-        }
+        hit = !s->load_is_new; /* the load itself was counted by on_load_done */
     } else if (same_source) {
         ds = sl_dataset_retain(cur->dataset); /* another technique or prepare-level parameter on the same data */
     } else {

@@ -176,7 +176,7 @@ void sl_session_free(sl_session *s)
     free(s->info_bounds);
     free(s->info_counts);
     free(s->info_attrs);
-    for (int i = 0; i < s->progress_count; i++)
+    for (int i = 0; i < SL_PROGRESS_RING; i++)
         free(s->progress_text[i]);
     cJSON_Delete(s->bounds);
     free(s);
@@ -287,8 +287,7 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     srv->client_count++;
     c->error_seq = s->error_seq;
     s->idle_since_ms = 0;
-    c->progress_round = s->progress_round;
-    c->progress_sent = s->progress_closed ? s->progress_count : 0;
+    c->progress_seq = s->progress_closed ? s->progress_seq : s->progress_round_start;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
     sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
@@ -818,8 +817,7 @@ void sl_sessions_on_wake(sl_server *srv)
         /* The session's newest render error is sent by write_next (coalesced:
          * a client that is behind gets the latest error once, not a backlog). */
         for (sl_client *c = s->clients; c; c = c->next)
-            if (c->error_seq != s->error_seq || c->progress_round != s->progress_round ||
-                c->progress_sent < s->progress_count)
+            if (c->error_seq != s->error_seq || c->progress_seq != s->progress_seq)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
@@ -924,16 +922,18 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
             return write_text_now(c, sl_msg_control_request_text(r->id));
         }
     }
-    /* Progress of the session's current round, each text once and in order;
-     * before errors, so a failed load's `done` precedes its load_failed. */
+    /* The session's progress texts, each once and in order (a client more
+     * than the ring behind skips the oldest); before errors, so a failed
+     * load's `done` precedes its load_failed. */
     char *progress = NULL;
     pthread_mutex_lock(&srv->lock);
-    if (c->progress_round != s->progress_round) {
-        c->progress_round = s->progress_round;
-        c->progress_sent = 0;
+    if (c->progress_seq != s->progress_seq) {
+        uint32_t next = c->progress_seq + 1, oldest = s->progress_seq - (SL_PROGRESS_RING - 1);
+        if (s->progress_seq >= SL_PROGRESS_RING && next < oldest)
+            next = oldest;
+        c->progress_seq = next;
+        progress = strdup(s->progress_text[next % SL_PROGRESS_RING]);
     }
-    if (c->progress_sent < s->progress_count)
-        progress = strdup(s->progress_text[c->progress_sent++]);
     pthread_mutex_unlock(&srv->lock);
     if (progress)
         return write_text_now(c, progress);

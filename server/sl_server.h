@@ -62,7 +62,7 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
-#define SL_PROGRESS_EVENTS 4           /* progress texts of one round: loading, preparing, first_frame, done */
+#define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
     int port;                      /* 0: any free port (printed on stdout) */
@@ -220,8 +220,7 @@ struct sl_client {                  /* [service] */
     sl_frame_buf *snapshot;         /* PNG waiting to be sent */
     uint32_t error_seq;             /* session error_seq already reported (set at attach) */
     int wants_control;              /* asked for control; the controller has not been told yet */
-    uint32_t progress_round;        /* the session's progress round being sent (set at attach) */
-    int progress_sent;              /* texts of that round already sent */
+    uint32_t progress_seq;          /* newest session progress text sent (set at attach) */
     int close_after_send;
     sl_client *next;                /* in session->clients */
 };
@@ -256,9 +255,10 @@ struct sl_session {
     double idle_since_ms;                    /* [lock] written by the service thread: 0 while
                                                 clients are attached, else when the last left */
     uint32_t progress_round;                 /* [lock] current round of long work (progress.c) */
-    int progress_count;                      /* [lock] its texts so far */
-    int progress_closed;                     /* [lock] its `done` was posted */
-    char *progress_text[SL_PROGRESS_EVENTS]; /* [lock] owned `progress` messages, in order */
+    uint32_t progress_seq;                   /* [lock] number of the newest progress text (0: none) */
+    uint32_t progress_round_start;           /* [lock] progress_seq before the current round's first */
+    int progress_closed;                     /* [lock] the current round's `done` was posted */
+    char *progress_text[SL_PROGRESS_RING];   /* [lock] owned texts, text n at n % SL_PROGRESS_RING */
     sl_session *next;                        /* [lock] in server->sessions */
     /* [service] */
     sl_client *clients;
@@ -270,7 +270,7 @@ struct sl_session {
     /* [render] */
     sl_prepared *prepared;                   /* the scene it renders through (a reference), or NULL */
     sl_dataset_load *load;                   /* the dataset load it waits for, or NULL */
-    int load_is_new;                         /* that load was queued for it (counts as a load) */
+    int load_is_new;                         /* that load was queued for it (a load, not a cache hit) */
     sl_progress_round round;
     sl_session_state good;                   /* the last state that rendered a frame */
     int has_good;
@@ -344,7 +344,8 @@ int sl_client_write_next(sl_server *srv, sl_client *c);
 typedef struct sl_dataset_cache sl_dataset_cache;  /* a sl_dataset_load is one load, shared by its waiters */
 typedef struct sl_dataset_cache_desc {
     int loaders;                 /* loader threads, 0 = SL_DATASET_LOADERS */
-    void (*on_done)(void *arg);  /* a load finished (loader thread, no cache lock held) */
+    /* A load finished: its status and time (loader thread, no cache lock held). */
+    void (*on_done)(void *arg, sl_status status, double load_ms);
     void *arg;
     double test_delay_ms;        /* tests only: every load sleeps this long first */
 } sl_dataset_cache_desc;

@@ -19,7 +19,10 @@
  *    load time or more — the render thread kept serving B;
  *  - C joins A's load while it is in flight: one more load in /metrics for
  *    both sessions (two more prepares: their parameters differ at the
- *    prepare level), and C's progress shows loading ... done too.
+ *    prepare level), and C's progress shows loading ... done too;
+ *  - A asks for "abc" (a load) and, once its `loading` arrives, for "tiny"
+ *    again (loaded: B shows it): the abc round ends with done, ok false, no
+ *    error comes, and A's next still frame shows the tiny state.
  * Prints B's longest gap in the load window and during A's prepare and
  * first frame (the part that still runs on the render thread, not bounded
  * here: that is the technique's prepare and render cost).
@@ -265,6 +268,45 @@ int main(void)
     SL_CHECK_MSG(prepares1 - prepares0 == 2, "prepares %g -> %g", prepares0, prepares1);
     SL_CHECK_MSG(pc.count == 4 && find_stage(&pc, "loading") == 0 && find_stage(&pc, "done") == 3,
                  "C's progress: %d messages", pc.count);
+
+    /* A load that is no longer wanted ends its round without a frame. */
+    progress_log ps = {0};
+    int errors = 0, sent_tiny = 0;
+    uint32_t v_tiny = 0;
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"abc\"}") == 0);
+    deadline = sl_clock_ms() + T;
+    while (ps.count < 2 && sl_clock_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(&a, 1000, &j);
+        if (r == 0)
+            break;
+        if (r != 1)
+            continue;
+        errors += strcmp(json_type(j), "error") == 0;
+        const cJSON *patch = cJSON_GetObjectItemCaseSensitive(j, "patch");
+        const char *dsname = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(patch, "dataset"));
+        if (dsname && strcmp(dsname, "tiny") == 0)
+            v_tiny = (uint32_t)num(j, "version");
+        log_progress(&ps, j);
+        if (ps.count == 1 && strcmp(ps.stage[0], "loading") == 0 && !sent_tiny) {
+            SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\"}") == 0);
+            sent_tiny = 1;
+        }
+    }
+    SL_CHECK_MSG(ps.count >= 2 && strcmp(ps.stage[0], "loading") == 0 && strcmp(ps.stage[1], "done") == 0 &&
+                 !cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(ps.msg[1], "ok")) &&
+                 strcmp(cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(ps.msg[1], "dataset")), "abc") == 0,
+                 "abc superseded by tiny: %d progress messages (%s, %s)", ps.count, ps.count > 0 ? ps.stage[0] : "",
+                 ps.count > 1 ? ps.stage[1] : "");
+    if (!v_tiny) {
+        cJSON *j = tclient_wait_type(&a, "state", T);
+        v_tiny = j ? (uint32_t)num(j, "version") : 0;
+        cJSON_Delete(j);
+    }
+    SL_CHECK(v_tiny > 0 && tclient_wait_version(&a, v_tiny, T) == 0);
+    SL_CHECK_MSG(errors == 0, "A got %d errors while switching away from a load", errors);
+    for (int i = 0; i < ps.count; i++)
+        cJSON_Delete(ps.msg[i]);
 
     for (int i = 0; i < pa.count; i++)
         cJSON_Delete(pa.msg[i]);
