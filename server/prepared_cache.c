@@ -7,7 +7,12 @@
  * the frame level (sl_params_compare < SL_INVALIDATE_PREPARED) render
  * through one prepared scene, so N such sessions cost one prepare and one
  * copy; frame-level parameters (colormap, radius, ...) are handed to the
- * pipeline at every render (techniques re-sync what they cache from them).
+ * pipeline at every render (techniques re-sync what they cache from them;
+ * a scene made for exactly a session's values is preferred, because a
+ * technique may rebuild a cache in render when a frame-level value changes:
+ * voxel_lines re-voxelizes for another `attribute`, so two sessions that
+ * share its scene and render by turns with different attributes pay that
+ * on every switch).
  * The pipeline's target follows the size of the frame it last rendered.
  * Reference-counted by the sessions holding it; the last release destroys
  * it (GL objects too). Render thread only (it owns every GL object), so no
@@ -24,12 +29,14 @@
 sl_prepared *sl_prepared_find(sl_prepared_cache *c, const char *source, const sl_technique *t,
                               const sl_params *params, const sl_dataset *ds)
 {
-    for (sl_prepared *p = c->list; p; p = p->next)
-        if (p->technique == t && p->dataset == ds && strcmp(p->source, source) == 0 &&
-            sl_params_compare(&p->key, params) < SL_INVALIDATE_PREPARED) {
-            p->refs++;
-            return p;
-        }
+    /* First a scene made for exactly these values, then one that differs at the frame level only. */
+    for (int pass = 0; pass < 2; pass++)
+        for (sl_prepared *p = c->list; p; p = p->next)
+            if (p->technique == t && p->dataset == ds && strcmp(p->source, source) == 0 &&
+                sl_params_compare(&p->key, params) <= (pass ? SL_INVALIDATE_FRAME : SL_INVALIDATE_NONE)) {
+                p->refs++;
+                return p;
+            }
     return NULL;
 }
 
