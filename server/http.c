@@ -122,7 +122,8 @@ char *sl_http_metrics(sl_server *srv)
     append(&b, &len, &cap, "# HELP sightline_sessions Live sessions.\n# TYPE sightline_sessions gauge\n"
            "sightline_sessions %d\n", sessions);
     append(&b, &len, &cap, "# HELP sightline_prepared_scenes Prepared technique states held (shared by the sessions "
-           "showing the same scene).\n# TYPE sightline_prepared_scenes gauge\nsightline_prepared_scenes %d\n", prepared);
+           "showing the same scene).\n# TYPE sightline_prepared_scenes gauge\nsightline_prepared_scenes %d\n",
+           prepared);
     histogram(&b, &len, &cap, "sightline_render_ms", "Render plus readback wall time per frame (no prepare), ms.",
               &m.render_ms);
     histogram(&b, &len, &cap, "sightline_dataset_load_ms", "Dataset load or generation time on a loader thread, ms.",

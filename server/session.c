@@ -9,7 +9,11 @@
  * requester (wants_control), told to the controller once by write_next, so
  * repeats merge and only a client's own replies fill its reply ring. A
  * session with no clients lives on for the grace period, then is doomed;
- * the render thread frees it with its GL state.
+ * the render thread frees it with its GL state (and, --idle-release seconds
+ * after its last client left, already lets go of its prepared scene:
+ * idle_since_ms). Progress texts (render thread) reach each client once, in
+ * order, from the session's ring; a client joining mid-round gets the
+ * round from its start.
  * Flow control: state changes reach each client as one coalesced `state`
  * patch (newest wins), frames as the session's latest frame, and only while
  * the client has fewer than SL_PROTO_ACK_WINDOW unacknowledged frames.

@@ -28,7 +28,8 @@ export class ProgressOverlay {
     this.round = msg.round;
     this.stage = msg.stage;
     this.since = performance.now() - (msg.elapsed_ms || 0);
-    this.text = `${LABELS[msg.stage] || msg.stage} ${msg.dataset}` + (msg.stage === 'loading' ? '' : ` (${msg.technique})`);
+    const what = msg.stage === 'loading' ? msg.dataset : `${msg.dataset} (${msg.technique})`;
+    this.text = `${LABELS[msg.stage] || msg.stage} ${what}`;
     const known = typeof msg.fraction === 'number';
     this.root.classList.toggle('indeterminate', !known);
     this.fill.style.width = known ? `${Math.round(msg.fraction * 100)}%` : '';
