@@ -185,6 +185,20 @@ static void shared_session(const harness *h)
     tclient_close(&ctl);
 }
 
+static long rss_kib(pid_t pid)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE *f = fopen(path, "r");
+    long kib = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmRSS:", 6) == 0)
+            kib = atol(line + 6);
+    if (f)
+        fclose(f);
+    return kib;
+}
+
 static double healthz_ms(int port)
 {
     double t0 = sl_clock_ms();
@@ -221,7 +235,7 @@ int main(void)
     pthread_barrier_wait(&barrier);          /* all connected: round 1 starts */
     double worst = 0;
     pthread_barrier_wait(&barrier);          /* round 1 sent and drained */
-    long rss1 = harness_rss_kib(h.pid);
+    long rss1 = rss_kib(h.pid);
     double hz = healthz_ms(h.port);
     worst = fmax(worst, hz);
     pthread_barrier_wait(&barrier);          /* round 2 starts */
@@ -232,7 +246,7 @@ int main(void)
     for (int i = 0; i < CLIENTS; i++)
         pthread_join(th[i], NULL);
     double total_ms = sl_clock_ms() - t0;
-    long rss2 = harness_rss_kib(h.pid);
+    long rss2 = rss_kib(h.pid);
 
     int connected = 0, final_ok = 0, frames = 0;
     for (int i = 0; i < CLIENTS; i++) {
