@@ -25,7 +25,9 @@
  * lws_cancel_service. Lock order: sl_server.lock, then the cache's lock.
  * Fields marked "[service]" or "[render]" belong to that thread alone.
  * Nothing is queued without a bound: state is "newest wins", a session keeps
- * one latest frame, a client keeps at most SL_CLIENT_MAX_TEXT replies.
+ * one latest frame and its newest SL_PROGRESS_RING progress texts, a client
+ * keeps at most SL_CLIENT_MAX_TEXT replies, and a session waits for at most
+ * one dataset load (so the loaders' queue is bounded by the sessions).
  * Only a client's own requests go into its reply ring (so only it can fill
  * it and get closed for it); whatever other clients or the render thread
  * cause reaches it as coalesced state on the client or session — the state
