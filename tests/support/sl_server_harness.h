@@ -519,6 +519,34 @@ static __attribute__((unused)) double harness_healthz_number(int port, const cha
     return p ? atof(p + strlen(pat)) : -1;
 }
 
+/* VmRSS of process pid in KiB (/proc/<pid>/status), or -1. */
+static __attribute__((unused)) long harness_rss_kib(pid_t pid)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE *f = fopen(path, "r");
+    long kib = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmRSS:", 6) == 0)
+            kib = atol(line + 6);
+    if (f)
+        fclose(f);
+    return kib;
+}
+
+/* Polls /metrics (every 50 ms) until metric `name` equals want; returns 0,
+ * or -1 after timeout_ms (the server has no push for its metrics). */
+static __attribute__((unused)) int harness_wait_metric(int port, const char *name, double want, int timeout_ms)
+{
+    double deadline = sl_clock_ms() + timeout_ms;
+    while (harness_metric(port, name) != want) {
+        if (sl_clock_ms() > deadline)
+            return -1;
+        usleep(50000);
+    }
+    return 0;
+}
+
 static __attribute__((unused)) int tclient_hello(tclient *c, const char *session, const char *token, int w, int h)
 {
     int rc;
