@@ -33,6 +33,7 @@
 #include <time.h>
 
 #include "data/sl_generate.h"
+#include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
 
 enum load_state { LOAD_QUEUED, LOAD_RUNNING, LOAD_DONE };
@@ -150,7 +151,10 @@ static void *loader_main(void *arg)
             sleep_ms(c->desc.test_delay_ms);
         sl_dataset *ds = NULL;
         sl_err err = {0};
-        sl_status rc = l->is_file ? sl_load_file(l->source, &ds, &err) : sl_generate_json(l->source, &ds, &err);
+        /* Files confined to the data directories (the catalog resolved them there; a
+         * file swapped for a symlink since is refused), generator JSON as it is. */
+        sl_dataset_dirs dirs = {.dirs = c->desc.data_dirs, .count = c->desc.data_dir_count, .confine = 1};
+        sl_status rc = sl_dataset_open(l->source, l->is_file ? &dirs : NULL, &ds, &err);
         double ms = sl_clock_ms() - t0;
         pthread_mutex_lock(&c->lock);
         l->status = rc;

@@ -586,7 +586,8 @@ static void *render_main(void *arg)
     sl_status st = sl_gpu_create(&desc, &ctx.gpu, &err);
     if (st == SL_OK)
         st = sl_encoder_create(&ctx.enc, &err);
-    sl_dataset_cache_desc dc = {.on_done = on_load_done, .arg = srv, .test_delay_ms = srv->cfg.test_load_delay_ms};
+    sl_dataset_cache_desc dc = {.on_done = on_load_done, .arg = srv, .test_delay_ms = srv->cfg.test_load_delay_ms,
+                                .data_dirs = srv->cfg.data_dirs, .data_dir_count = srv->cfg.data_dir_count};
     if (st == SL_OK)
         st = sl_dataset_cache_create(&dc, &ctx.datasets, &err);
     ctx.prepared.gpu = ctx.gpu;

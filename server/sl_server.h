@@ -350,6 +350,8 @@ typedef struct sl_dataset_cache_desc {
     void (*on_done)(void *arg, sl_status status, double load_ms);
     void *arg;
     double test_delay_ms;        /* tests only: every load sleeps this long first */
+    const char *const *data_dirs; /* borrowed: a file must lie inside one (sl_dataset_open's confinement) */
+    int data_dir_count;
 } sl_dataset_cache_desc;
 typedef enum sl_dataset_origin {
     SL_DATASET_CACHED,      /* *out is set: no load */
