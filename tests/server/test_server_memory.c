@@ -43,11 +43,7 @@ static int open_session(tclient *c, int port)
 
 int main(void)
 {
-    /* A small ASan quarantine, so resident memory reflects live data, not freed buffers. */
-    const char *asan = getenv("ASAN_OPTIONS");
-    char opts[512];
-    snprintf(opts, sizeof opts, "%s%squarantine_size_mb=8", asan ? asan : "", asan && asan[0] ? ":" : "");
-    setenv("ASAN_OPTIONS", opts, 1);
+    harness_small_asan_quarantine();
     harness h;
     const char *extra[] = {"--default-dataset", "tornado", "--idle-release", "1", NULL};
     if (harness_start(&h, extra) != 0) {
