@@ -7,6 +7,12 @@ uniform vec3 u_dims;            // voxels per axis
 uniform vec2 u_value_map;       // scale, offset
 uniform int u_nearest;
 
+// NaN by its bits: a compiler may fold isnan(x) (x != x) away.
+bool sl_is_nan(float x)
+{
+    return (floatBitsToUint(x) & 0x7fffffffu) > 0x7f800000u;
+}
+
 float sl_volume_value(vec3 p)
 {
     float t;

@@ -53,7 +53,7 @@ vec3 shade(vec3 base, vec3 p, vec3 view_dir)
 {
     vec3 g = sl_volume_gradient(p) * u_inv_spacing;
     float m = max(max(abs(g.x), abs(g.y)), abs(g.z));
-    if (!(m > 0.0) || isinf(m))   // zero (constant region), NaN or overflow: unlit
+    if (!(m > 0.0 && m < 3.0e38)) // zero (constant region), NaN or overflow: unlit
         return base;
     vec3 n = normalize(g / m);
     sl_material mat = sl_material(u_material.x, u_material.y, u_material.z, u_material.w);
@@ -91,7 +91,7 @@ void main()
     float vmax = -1.0 / 0.0;        // mip: running maximum of the finite samples
     bool any = false;
     float prev = sl_volume_value(u_eye_v + t0 * rd), prev_t = t0; // iso: the entry sample
-    bool prev_ok = u_mode == 2 && !isnan(prev);
+    bool prev_ok = u_mode == 2 && !sl_is_nan(prev);
     if (u_mode == 2)
         taken++;
     float hit_t = -1.0;
@@ -124,7 +124,7 @@ void main()
         float v = sl_volume_value(p);
         taken++;
         k++;
-        if (isnan(v)) {
+        if (sl_is_nan(v)) {
             prev_ok = false;
             continue;
         }
@@ -149,7 +149,7 @@ void main()
                 for (int it = 0; it < 12; it++) {
                     float tm = 0.5 * (ta + tc);
                     float sm = sl_volume_value(u_eye_v + tm * rd) - u_iso;
-                    if (isnan(sm))
+                    if (sl_is_nan(sm))
                         break;
                     if ((sa < 0.0) != (sm < 0.0)) {
                         tc = tm;
