@@ -134,3 +134,8 @@ foreach(scene composite mip iso)
     "-DSTEP2=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/volume_${scene}.png|${VOLUME_DIR}/${scene}.golden.png|--diff|${SL_RENDER_OUT}/volume_${scene}.diff.png|${VOLUME_GOLDEN_ARGS}"
     ${SL_STEPS})
 endforeach()
+
+# sightline-info counts NaN voxels (f32): a 2x2x1 raw volume with two NaN,
+# one 1e30 and one 0.5 (little-endian bytes written by printf).
+volume_test(info_counts_nan
+  sh -c "printf '\\000\\000\\300\\177\\000\\000\\000\\077\\000\\000\\300\\177\\312\\362\\111\\161' > ${SL_RENDER_OUT}/nan4.raw && printf '{\"raw\":\"nan4.raw\",\"dims\":[2,2,1],\"type\":\"f32\"}' > ${SL_RENDER_OUT}/nan4.json && $<TARGET_FILE:sightline-info> ${SL_RENDER_OUT}/nan4.json | tee /dev/stderr | grep -q '\"nan_voxels\":[[:space:]]*2'")
