@@ -15,6 +15,11 @@
  *    fraction of frame 0.
  * 2. Modes at step 0.5: composite, composite + shading, mip, iso, skipping
  *    on and off.
+ * 3. Peers (unless --vtk 0): the same volume, transfer function, cameras,
+ *    sizes and step 0.5 through VTK's vtkGPUVolumeRayCastMapper and
+ *    vtkFixedPointVolumeRayCastMapper (bench/vtk_volume.py under xvfb-run,
+ *    the same llvmpipe): error against the same reference and frame time,
+ *    with the ratio peer / ours.
  * Prints Markdown; checks nothing (tests/render/volume_dvr.cmake does).
  * Numbers on llvmpipe depend on what else runs on the machine.
  */
@@ -32,6 +37,7 @@
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
 #include "harness/sl_bench.h"
+#include "image/sl_image.h"
 #include "pipeline/sl_pipeline.h"
 #include "sl_params_json.h"
 #include "volume_reference.h"
@@ -42,14 +48,14 @@ typedef struct options {
     sl_bench_options bench;
     double steps[MAX_STEPS];
     int step_count;
-    int error_w, error_h, volume_size;
+    int error_w, error_h, volume_size, vtk;
     char datasets[64];
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
 {
     *o = (options){.steps = {2, 1, 0.5, 0.25, 0.125}, .step_count = 5, .error_w = 160, .error_h = 90,
-                   .volume_size = 256};
+                   .volume_size = 256, .vtk = 1};
     snprintf(o->datasets, sizeof o->datasets, "ml,head,ct");
     sl_bench_options_init(&o->bench, 3);
     for (int i = 1; i < argc; i++) {
@@ -79,6 +85,8 @@ static int parse_args(int argc, char **argv, options *o)
         } else if (strcmp(a, "--volume-size") == 0) {
             if (sl_bench_parse_int(v, 16, 512, &o->volume_size) != 0)
                 return fprintf(stderr, "bench-volume-dvr: --volume-size in [16, 512]\n"), 0;
+        } else if (strcmp(a, "--vtk") == 0) {
+            o->vtk = atoi(v) != 0;
         } else if (strcmp(a, "--datasets") == 0) {
             snprintf(o->datasets, sizeof o->datasets, "%s", v);
         } else {
@@ -192,6 +200,129 @@ static sl_status time_both(sl_pipeline *p, const sl_technique *t, sl_params para
     return st;
 }
 
+/* ---- peers: VTK's mappers on the same volume and cameras ---- */
+
+static const char *source_dir(void)
+{
+    const char *src = getenv("SIGHTLINE_SOURCE_DIR");
+    return src ? src : SIGHTLINE_SOURCE_DIR;
+}
+
+/* Writes one camera line per frame: "VIEW INDEX eye target up fov" (warm-up -1 when frames > 1). */
+static sl_status write_cameras(const char *path, const sl_dataset *ds, int frames, sl_err *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return sl_err_set(err, SL_ERR_IO, "cannot write %s", path);
+    sl_status st = SL_OK;
+    for (int k = frames > 1 ? -1 : 0; st == SL_OK && k < frames; k++) {
+        sl_camera c;
+        if ((st = sl_bench_orbit_camera(ds, k < 0 ? 0 : k, frames, &orbit, &c, err)) == SL_OK)
+            fprintf(f, "v %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k, c.eye.x, c.eye.y,
+                    c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fov_y_deg);
+    }
+    fclose(f);
+    return st;
+}
+
+/* Runs vtk_volume.py; fills *ms (median) or returns a reason in err. */
+static sl_status run_vtk(const char *dir, const sl_dataset *ds, const sl_transfer_function *tf, const char *mapper,
+                         double step, int w, int h, const char *cameras, const char *png, double *ms, sl_err *err)
+{
+    static const char *const types[] = {"uint8", "uint16", "int16", "float32"};
+    const sl_volume *v = &ds->volume;
+    char tfs[2048] = "";
+    for (int k = 0; k < tf->count; k++)
+        snprintf(tfs + strlen(tfs), sizeof tfs - strlen(tfs), "%s%.9g,%g,%g,%g,%g", k ? ";" : "", tf->point[k][0],
+                 tf->point[k][1], tf->point[k][2], tf->point[k][3], tf->point[k][4]);
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "xvfb-run -a /usr/bin/python3 %s/bench/vtk_volume.py --raw %s/volume.raw --type %s "
+             "--dims %d %d %d --spacing %.17g %.17g %.17g --origin %.17g %.17g %.17g --tf='%s' --step %g --mapper %s "
+             "--cameras %s --size %dx%d --background 0.1,0.1,0.12%s%s 2>/dev/null", source_dir(), dir, types[v->type],
+             v->dims[0], v->dims[1], v->dims[2], v->spacing[0], v->spacing[1], v->spacing[2], ds->origin.x,
+             ds->origin.y, ds->origin.z, tfs, step, mapper, cameras, w, h, png ? " --png " : "", png ? png : "");
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return sl_err_set(err, SL_ERR_IO, "cannot run xvfb-run");
+    char line[8192] = "";
+    while (fgets(line, sizeof line, p) && line[0] != '{')
+        ;
+    pclose(p);
+    cJSON *j = cJSON_Parse(line);
+    const cJSON *ok = cJSON_GetObjectItemCaseSensitive(j, "ok");
+    sl_status st = SL_OK;
+    if (!cJSON_IsTrue(ok)) {
+        const cJSON *e = cJSON_GetObjectItemCaseSensitive(j, "error");
+        st = sl_err_set(err, SL_ERR_UNSUPPORTED, "vtk_volume.py: %s", cJSON_IsString(e) ? e->valuestring : "no output");
+    } else {
+        const cJSON *views = cJSON_GetObjectItemCaseSensitive(j, "views");
+        const cJSON *m = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(views, "v"), "median_ms");
+        *ms = cJSON_IsNumber(m) ? m->valuedouble : 0.0;
+    }
+    cJSON_Delete(j);
+    return st;
+}
+
+static void peers(const options *o, const sl_dataset *ds, const sl_transfer_function *tf, const uint8_t *ref,
+                  int ew, int eh, double ours_error, double ours_ms)
+{
+    char dir[] = "/tmp/sl-bench-volume-XXXXXX";
+    if (!mkdtemp(dir)) {
+        printf("\nVTK peers: no temporary folder\n");
+        return;
+    }
+    char raw[128], cam_e[128], cam_t[128], png[128], png_file[160];
+    snprintf(raw, sizeof raw, "%s/volume.raw", dir);
+    snprintf(cam_e, sizeof cam_e, "%s/error.txt", dir);
+    snprintf(cam_t, sizeof cam_t, "%s/time.txt", dir);
+    snprintf(png, sizeof png, "%s/vtk", dir);
+    snprintf(png_file, sizeof png_file, "%s-v.png", png);
+    const sl_volume *v = &ds->volume;
+    size_t n = (size_t)v->dims[0] * v->dims[1] * v->dims[2];
+    FILE *f = fopen(raw, "wb");
+    int wrote = f && fwrite(v->data, sl_voxel_type_size(v->type), n, f) == n;
+    if (f)
+        fclose(f);
+    sl_err err = {0};
+    printf("\n### Peers at step 0.5: VTK (same volume, transfer function, cameras; xvfb-run, the same llvmpipe)\n\n");
+    printf("| renderer | mean abs dRGB vs reference (%dx%d) | wall ms (%dx%d) | ratio peer / ours |\n", ew, eh,
+           o->bench.width, o->bench.height);
+    printf("|---|---:|---:|---:|\n");
+    printf("| volume_dvr | %.3f | %.1f | 1.00 |\n", ours_error, ours_ms);
+    static const char *const mappers[] = {"gpu", "fixed"};
+    static const char *const names[] = {"vtkGPUVolumeRayCastMapper", "vtkFixedPointVolumeRayCastMapper"};
+    for (int m = 0; wrote && m < 2; m++) {
+        double ms = 0, unused = 0;
+        sl_image img = {0};
+        sl_status st = write_cameras(cam_e, ds, 1, &err);
+        if (st == SL_OK)
+            st = run_vtk(dir, ds, tf, mappers[m], 0.5, ew, eh, cam_e, png, &unused, &err);
+        if (st == SL_OK)
+            st = sl_png_read(png_file, &img, &err);
+        double mean = -1;
+        if (st == SL_OK && img.width == ew && img.height == eh) {
+            double sum = 0;
+            for (size_t i = 0; i < (size_t)ew * eh; i++)
+                for (int c = 0; c < 3; c++)
+                    sum += abs((int)img.rgba[4 * i + c] - (int)ref[4 * i + c]);
+            mean = sum / (3.0 * ew * eh);
+        }
+        sl_image_deinit(&img);
+        if (st == SL_OK && (st = write_cameras(cam_t, ds, o->bench.frames, &err)) == SL_OK)
+            st = run_vtk(dir, ds, tf, mappers[m], 0.5, o->bench.width, o->bench.height, cam_t, NULL, &ms, &err);
+        if (st != SL_OK)
+            printf("| %s | — | — | (%s) |\n", names[m], err.message);
+        else
+            printf("| %s | %.3f | %.1f | %.2f |\n", names[m], mean, ms, ours_ms > 0 ? ms / ours_ms : 0);
+        fflush(stdout);
+    }
+    unlink(raw);
+    unlink(cam_e);
+    unlink(cam_t);
+    unlink(png_file);
+    rmdir(dir);
+}
+
 static sl_status run_dataset(sl_gpu *gpu, const options *o, const bench_dataset *b, sl_err *err)
 {
     sl_dataset *ds = NULL;
@@ -236,6 +367,7 @@ static sl_status run_dataset(sl_gpu *gpu, const options *o, const bench_dataset 
         printf("| step | mean abs dRGB | max abs dRGB | wall ms, skipping on | off | on / off | skipped fraction |\n");
         printf("|---:|---:|---:|---:|---:|---:|---:|\n");
     }
+    double ours_error_05 = -1, ours_ms_05 = 0;
     for (int s = 0; st == SL_OK && s < o->step_count; s++) {
         double mean = 0, frac = 0;
         int max = 0;
@@ -246,14 +378,18 @@ static sl_status run_dataset(sl_gpu *gpu, const options *o, const bench_dataset 
             (st = skipped_fraction(p, t, &q, &bv, &frac, err)) != SL_OK ||
             (st = time_both(p, t, q, o, &on, &off, err)) != SL_OK)
             break;
+        if (o->steps[s] == 0.5) {
+            ours_error_05 = mean;
+            ours_ms_05 = on.median_ms;
+        }
         printf("| %g | %.3f | %d | %.1f (%.1f-%.1f) | %.1f | %.2f | %.3f |\n", o->steps[s], mean, max, on.median_ms,
                on.min_ms, on.max_ms, off.median_ms, off.median_ms > 0 ? on.median_ms / off.median_ms : 0, frac);
         fflush(stdout);
     }
     if (st == SL_OK) {
-        printf("\n### Modes at step 0.5 (%dx%d)\n\n| mode | wall ms, skipping on | off | skipped fraction | prepare ms | GPU MB |\n",
+        printf("\n### Modes at step 0.5 (%dx%d)\n\n| mode | wall ms, skipping on | off | skipped fraction | GPU MB |\n",
                o->bench.width, o->bench.height);
-        printf("|---|---:|---:|---:|---:|---:|\n");
+        printf("|---|---:|---:|---:|---:|\n");
     }
     static const char *const modes[] = {"composite", "composite + shading", "mip", "iso"};
     for (int m = 0; st == SL_OK && m < 4; m++) {
@@ -266,9 +402,20 @@ static sl_status run_dataset(sl_gpu *gpu, const options *o, const bench_dataset 
             (st = skipped_fraction(p, t, &q, &bv, &frac, err)) != SL_OK ||
             (st = time_both(p, t, q, o, &on, &off, err)) != SL_OK)
             break;
-        printf("| %s | %.1f (%.1f-%.1f) | %.1f | %.3f | %.0f | %.1f |\n", modes[m], on.median_ms, on.min_ms, on.max_ms,
-               off.median_ms, frac, on.prepare_ms, on.gpu_bytes / 1048576.0);
+        printf("| %s | %.1f (%.1f-%.1f) | %.1f | %.3f | %.1f |\n", modes[m], on.median_ms, on.min_ms, on.max_ms,
+               off.median_ms, frac, on.gpu_bytes / 1048576.0);
         fflush(stdout);
+    }
+    if (st == SL_OK && o->vtk) {
+        if (ours_error_05 < 0) {
+            sl_bench_timing on, off;
+            sl_params q = params;
+            if ((st = frame_error(p, t, params, 0.5, &ev, ref, buf, &ours_error_05, &(int){0}, err)) == SL_OK &&
+                (st = sl_bench_set(&q, "step", 0.5, err)) == SL_OK && (st = time_both(p, t, q, o, &on, &off, err)) == SL_OK)
+                ours_ms_05 = on.median_ms;
+        }
+        if (st == SL_OK)
+            peers(o, pds, tf, ref, o->error_w, o->error_h, ours_error_05, ours_ms_05);
     }
     free(ref);
     free(buf);
