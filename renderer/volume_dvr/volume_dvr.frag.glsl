@@ -95,6 +95,7 @@ void main()
     if (u_mode == 2)
         taken++;
     float hit_t = -1.0;
+    float brick_exit = -1.0;        // samples before this t lie in a brick found visible
     for (int k = 0; k <= n;) {
         float tk, kexp;
         if (k < n) {
@@ -107,19 +108,21 @@ void main()
             kexp = rem / u_min_spacing;
         }
         vec3 p = u_eye_v + tk * rd;
-        if (u_skipping != 0) {
+        if (u_skipping != 0 && tk >= brick_exit) {
+            // Entering a brick: look it up once; its samples up to brick_exit need no test.
             ivec3 b = brick_of(p);
+            vec3 blo = vec3(b) * BRICK;
+            float texit = sl_volume_ray_box(u_eye_v, inv_rd, blo, blo + BRICK).y;
             bool skip = texelFetch(u_mask, b, 0).r == 0u;
             if (!skip && u_mode == 1)
                 skip = texelFetch(u_minmax, b, 0).g <= vmax;
             if (skip) {
-                vec3 blo = vec3(b) * BRICK;
-                float texit = sl_volume_ray_box(u_eye_v, inv_rd, blo, blo + BRICK).y;
                 int k2 = k < n ? clamp(int(ceil((texit - t0) / dt - off)), k + 1, n) : n + 1;
                 skipped += uint(k2 - k);
                 k = k2;
                 continue;
             }
+            brick_exit = texit;
         }
         float v = sl_volume_value(p);
         taken++;

@@ -16,7 +16,9 @@ endfunction()
 # pixel), mip max <= 1, iso distance within 1e-3 of the box diagonal over the
 # pixels both hit, at most 0.5 % of the hit pixels hit in one image only.
 # Measured (llvmpipe): composite mean <= 0.0001, max 1; mip max <= 1; iso
-# distance error <= 3.6e-6 of the diagonal, no pixel hit by one only. The
+# distance error <= 3.6e-6 of the diagonal, no pixel hit by one only;
+# composite depth <= 6.9e-7 (ML), one pixel of the CT one step (6.3e-4) off
+# where alpha reaches 0.5 within rounding of a sample. The
 # transfer functions put colour and opacity where each field has structure.
 set(ML "{\"generator\":\"marschner_lobb\",\"size\":41}")
 set(ML_TF "[[0.3,0,0,0,0],[0.5,1,0.6,0.2,0.3],[0.7,0.2,0.5,1,0.6]]")
@@ -35,7 +37,7 @@ foreach(case "ml;${ML};${ML_TF};${ML_TF};0.5" "torus;${TORUS};${TORUS_TF};${TORU
   list(GET case 3 mip_tf)
   list(GET case 4 iso)
   volume_test(reference.${name}.composite volume-check compare --dataset ${src} --size 128
-    --params "{\"step\":0.25,\"transfer_function\":${tf}}" --tol-mean 1 --tol-max 4)
+    --params "{\"step\":0.25,\"transfer_function\":${tf}}" --tol-mean 1 --tol-max 4 --depth-tol 1e-3)
   volume_test(reference.${name}.mip volume-check compare --dataset ${src} --size 128
     --params "{\"step\":0.25,\"mode\":\"mip\",\"transfer_function\":${mip_tf}}" --tol-mean 1 --tol-max 1)
   volume_test(reference.${name}.iso volume-check compare --dataset ${src} --size 128

@@ -192,6 +192,44 @@ static int frame(rig *r, const sl_view *view, uint8_t *rgba, float *dist, sl_fra
     return 1;
 }
 
+/* Distances of the frame (gd) and the reference (rd): max and mean error over
+ * the pixels both hit, relative to the box diagonal, and the pixels hit by one only. */
+static void compare_depth(const options *o, const sl_dataset *ds, const volume_ref_desc *d, const float *gd,
+                          const float *rd, size_t n, const char *what)
+{
+    double diag = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double e = ds->volume.dims[a] > 1 ? (ds->volume.dims[a] - 1) * ds->volume.spacing[a] : ds->volume.spacing[a];
+        diag += e * e;
+    }
+    diag = sqrt(diag);
+    double worst = 0.0, sum = 0.0;
+    size_t both = 0, one = 0, hit = 0;
+    for (size_t i = 0; i < n; i++) {
+        int a = gd[i] > 0.0f, b = rd[i] > 0.0f;
+        hit += (size_t)(a || b);
+        if (a && b) {
+            double e = fabs((double)gd[i] - rd[i]) / diag;
+            worst = e > worst ? e : worst;
+            sum += e;
+            both++;
+        } else if (a != b) {
+            one++;
+        }
+    }
+    double miss_pct = hit ? 100.0 * one / hit : 0.0;
+    printf("volume-check: %s %s step %g: distance error / diagonal max %.3g mean %.3g over %zu pixels hit by both; "
+           "hit by one only %zu (%.2f %% of %zu hit)\n", o->dataset, what, d->step, worst, both ? sum / both : 0.0, both,
+           one, miss_pct, hit);
+    if (both == 0)
+        FAIL("%s: no pixel has a distance", what);
+    if (o->depth_tol >= 0 && worst > o->depth_tol)
+        FAIL("%s: distance error %.3g of the diagonal > %g", what, worst, o->depth_tol);
+    if (miss_pct > o->max_miss_pct)
+        FAIL("%s: %.2f %% of the pixels with a distance have one in one image only > %g %%", what, miss_pct,
+             o->max_miss_pct);
+}
+
 static int compare(const options *o)
 {
     sl_err err = {0};
@@ -247,6 +285,8 @@ static int compare(const options *o)
         sl_png_write(path, ref, o->size, o->size, &err);
     }
     rc = 0;
+    if (d.mode == VOLUME_REF_COMPOSITE && o->depth_tol >= 0)
+        compare_depth(o, ds, &d, gd, rd, n, "composite (alpha > 0.5)");
     if (d.mode != VOLUME_REF_ISO) {
         double sum = 0.0;
         int mx = 0;
@@ -271,36 +311,7 @@ static int compare(const options *o)
         if (mx > o->tol_max)
             FAIL("max |dRGB| %d > %g", mx, o->tol_max);
     } else {
-        double diag = 0.0;
-        for (int a = 0; a < 3; a++) {
-            double e = ds->volume.dims[a] > 1 ? (ds->volume.dims[a] - 1) * ds->volume.spacing[a] : ds->volume.spacing[a];
-            diag += e * e;
-        }
-        diag = sqrt(diag);
-        double worst = 0.0, sum = 0.0;
-        size_t both = 0, one = 0, hit = 0;
-        for (size_t i = 0; i < n; i++) {
-            int a = gd[i] > 0.0f, b = rd[i] > 0.0f;
-            hit += (size_t)(a || b);
-            if (a && b) {
-                double e = fabs((double)gd[i] - rd[i]) / diag;
-                worst = e > worst ? e : worst;
-                sum += e;
-                both++;
-            } else if (a != b) {
-                one++;
-            }
-        }
-        double miss_pct = hit ? 100.0 * one / hit : 0.0;
-        printf("volume-check: %s iso %g step %g: distance error / diagonal max %.3g mean %.3g over %zu pixels hit by "
-               "both; hit by one only %zu (%.2f %% of %zu hit)\n", o->dataset, d.iso, d.step, worst,
-               both ? sum / both : 0.0, both, one, miss_pct, hit);
-        if (both == 0)
-            FAIL("no pixel hit the isosurface");
-        if (o->depth_tol >= 0 && worst > o->depth_tol)
-            FAIL("distance error %.3g of the diagonal > %g", worst, o->depth_tol);
-        if (miss_pct > o->max_miss_pct)
-            FAIL("%.2f %% of the hit pixels hit in one image only > %g %%", miss_pct, o->max_miss_pct);
+        compare_depth(o, ds, &d, gd, rd, n, "iso");
     }
     if (o->max_samples >= 0 && st.render.samples > o->max_samples)
         FAIL("%.0f ray samples > %g", st.render.samples, o->max_samples);
