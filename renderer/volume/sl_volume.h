@@ -55,6 +55,13 @@ sl_status sl_volume_texture_create(const sl_volume *vol, sl_volume_texture *t, s
 void sl_volume_texture_destroy(sl_volume_texture *t); /* zeroed is fine */
 void sl_volume_texture_set_filter(const sl_volume_texture *t, int linear);
 
+/* A precomputed gradient: per voxel the central difference of the voxel
+ * values (one-sided at the edges, divided by the spacing: world units),
+ * normalized and stored as RGBA8_SNORM (xyz; zero where the difference is
+ * zero or touches NaN), filtered linearly. For shading only (direction).
+ * SL_ERR_NOMEM, SL_ERR_GPU; on failure *tex is 0. Counted as a gradient build. */
+sl_status sl_volume_gradient_create(const sl_volume *vol, GLuint *tex, size_t *bytes, sl_err *err);
+
 /* A transfer function resolved for a dataset: control points in data units,
  * piecewise linear, constant beyond the ends. The colormap form becomes the
  * union of the colormap's own control points and the opacity ramp's (exact:
@@ -128,6 +135,7 @@ typedef struct sl_volume_counters {
     unsigned long minmax_builds;     /* min-max grids built */
     unsigned long mask_builds;       /* visible-brick masks rebuilt and uploaded */
     unsigned long tf_uploads;        /* TF textures uploaded */
+    unsigned long gradient_builds;   /* precomputed gradient textures built */
 } sl_volume_counters;
 void sl_volume_get_counters(sl_volume_counters *out);
 

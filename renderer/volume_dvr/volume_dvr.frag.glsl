@@ -35,6 +35,8 @@ uniform ivec3 u_brick_dims;
 uniform vec3 u_background;
 uniform vec3 u_light_world;      // unit, towards the light
 uniform vec4 u_material;         // ambient, diffuse, specular, shininess
+uniform int u_gradient_tex;      // 1: normals from u_gradient, 0: central differences here
+uniform sampler3D u_gradient;    // unit gradients (volume_gradient.c)
 
 layout(std430, binding = 5) buffer sl_volume_sample_rows {
     uint rows[];                 // per pixel row: samples taken, samples skipped
@@ -51,11 +53,20 @@ ivec3 brick_of(vec3 p)
 
 vec3 shade(vec3 base, vec3 p, vec3 view_dir)
 {
-    vec3 g = sl_volume_gradient(p) * u_inv_spacing;
-    float m = max(max(abs(g.x), abs(g.y)), abs(g.z));
-    if (!(m > 0.0 && m < 3.0e38)) // zero (constant region), NaN or overflow: unlit
-        return base;
-    vec3 n = normalize(g / m);
+    vec3 n;
+    if (u_gradient_tex != 0) {
+        // Precomputed unit gradients, interpolated: too short where they cancel.
+        vec3 gn = textureLod(u_gradient, (p + 0.5) / u_dims, 0.0).xyz;
+        if (!(dot(gn, gn) > 1e-4))
+            return base;
+        n = normalize(gn);
+    } else {
+        vec3 g = sl_volume_gradient(p) * u_inv_spacing;
+        float m = max(max(abs(g.x), abs(g.y)), abs(g.z));
+        if (!(m > 0.0 && m < 3.0e38)) // zero (constant region), NaN or overflow: unlit
+            return base;
+        n = normalize(g / m);
+    }
     sl_material mat = sl_material(u_material.x, u_material.y, u_material.z, u_material.w);
     return sl_shade(base, n, u_light_world, view_dir, mat);
 }

@@ -357,8 +357,8 @@ static int counters_equal(const sl_volume_counters *a, const sl_volume_counters 
 }
 
 /* Applies a JSON patch, renders, and checks prepared and the counter deltas
- * (texture, minmax, mask, tf). */
-static void work_step(rig *r, const sl_view *view, const char *patch, const long want[4], const char *what)
+ * (texture, minmax, mask, tf, gradient). */
+static void work_step(rig *r, const sl_view *view, const char *patch, const long want[5], const char *what)
 {
     sl_err err = {0};
     cJSON *p = cJSON_Parse(patch);
@@ -373,14 +373,15 @@ static void work_step(rig *r, const sl_view *view, const char *patch, const long
         return;
     }
     sl_volume_get_counters(&after);
-    long got[4] = {(long)(after.texture_uploads - before.texture_uploads),
+    long got[5] = {(long)(after.texture_uploads - before.texture_uploads),
                    (long)(after.minmax_builds - before.minmax_builds),
-                   (long)(after.mask_builds - before.mask_builds), (long)(after.tf_uploads - before.tf_uploads)};
-    printf("volume-check: %s: prepared %d, volume uploads %ld, min-max builds %ld, mask builds %ld, TF uploads %ld\n",
-           what, st.prepared, got[0], got[1], got[2], got[3]);
+                   (long)(after.mask_builds - before.mask_builds), (long)(after.tf_uploads - before.tf_uploads),
+                   (long)(after.gradient_builds - before.gradient_builds)};
+    printf("volume-check: %s: prepared %d, volume uploads %ld, min-max builds %ld, mask builds %ld, TF uploads %ld, "
+           "gradient builds %ld\n", what, st.prepared, got[0], got[1], got[2], got[3], got[4]);
     if (st.prepared)
         FAIL("%s re-prepared", what);
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < 5; k++)
         if (got[k] != want[k])
             FAIL("%s: counter %d moved by %ld, expected %ld", what, k, got[k], want[k]);
 }
@@ -414,17 +415,22 @@ static int work(const options *o)
     if (!st.prepared || c1.texture_uploads != c0.texture_uploads + 1 || c1.minmax_builds != c0.minmax_builds + 1)
         FAIL("the first frame must prepare, upload the volume and build the min-max grid once");
     (void)counters_equal;
-    work_step(&r, &b, "{}", (const long[4]){0, 0, 0, 0}, "camera move");
-    work_step(&r, &a, "{}", (const long[4]){0, 0, 0, 0}, "camera back");
+    work_step(&r, &b, "{}", (const long[5]){0, 0, 0, 0, 0}, "camera move");
+    work_step(&r, &a, "{}", (const long[5]){0, 0, 0, 0, 0}, "camera back");
     work_step(&r, &a, "{\"transfer_function\": [[0, 0, 0, 0, 0], [0.6, 1, 0.5, 0, 0.3], [1, 1, 1, 1, 0.8]]}",
-              (const long[4]){0, 0, 1, 1}, "transfer function change");
-    work_step(&r, &b, "{}", (const long[4]){0, 0, 0, 0}, "camera move after the TF change");
+              (const long[5]){0, 0, 1, 1, 0}, "transfer function change");
+    work_step(&r, &b, "{}", (const long[5]){0, 0, 0, 0, 0}, "camera move after the TF change");
     work_step(&r, &a, "{\"step\": 0.3, \"shading\": true, \"interpolation\": \"nearest\", \"clip_max\": [0.8, 1, 1]}",
-              (const long[4]){0, 0, 0, 0}, "step, shading, interpolation, clip");
-    work_step(&r, &a, "{\"mode\": \"iso\"}", (const long[4]){0, 0, 1, 0}, "mode iso");
-    work_step(&r, &a, "{\"isovalue\": 0.4}", (const long[4]){0, 0, 1, 0}, "isovalue change");
-    work_step(&r, &a, "{\"mode\": \"mip\"}", (const long[4]){0, 0, 1, 0}, "mode mip");
-    work_step(&r, &b, "{}", (const long[4]){0, 0, 0, 0}, "camera move in mip");
+              (const long[5]){0, 0, 0, 0, 0}, "step, shading, interpolation, clip");
+    work_step(&r, &a, "{\"gradient\": \"texture\"}", (const long[5]){0, 0, 0, 0, 1}, "gradient texture, first use");
+    work_step(&r, &b, "{\"transfer_function\": [[0, 0, 0, 0, 0], [1, 1, 1, 1, 0.5]]}", (const long[5]){0, 0, 1, 1, 0},
+              "TF change with the gradient texture");
+    work_step(&r, &a, "{\"gradient\": \"on_the_fly\"}", (const long[5]){0, 0, 0, 0, 0}, "gradient on the fly");
+    work_step(&r, &a, "{\"gradient\": \"texture\"}", (const long[5]){0, 0, 0, 0, 0}, "gradient texture again");
+    work_step(&r, &a, "{\"mode\": \"iso\"}", (const long[5]){0, 0, 1, 0, 0}, "mode iso");
+    work_step(&r, &a, "{\"isovalue\": 0.4}", (const long[5]){0, 0, 1, 0, 0}, "isovalue change");
+    work_step(&r, &a, "{\"mode\": \"mip\"}", (const long[5]){0, 0, 1, 0, 0}, "mode mip");
+    work_step(&r, &b, "{}", (const long[5]){0, 0, 0, 0, 0}, "camera move in mip");
     rig_deinit(&r);
     return failures ? 1 : 0;
 }
