@@ -1,6 +1,7 @@
 /* params_json.c — technique parameters to and from JSON (see sl_params_json.h). */
 #include "sl_params_json.h"
 
+#include "core/sl_colormap.h"
 #include "data/sl_dataset.h"
 
 #include <math.h>
@@ -45,6 +46,76 @@ static sl_status apply_enum_number(sl_params *p, const sl_param_def *d, double v
     return sl_params_set_numbers(p, d->name, &v, 1, err);
 }
 
+/* A transfer function from JSON: [[value, r, g, b, a], ...] (data units) or
+ * {"colormap": name, "opacity": [[t, alpha], ...], "range": [lo, hi]}
+ * ("opacity" defaults to [[0, 0], [1, 1]], "range" to the dataset's value
+ * range). Shape errors name the point; value errors come from
+ * sl_params_set_transfer. */
+static sl_status apply_transfer(sl_params *p, const char *name, const cJSON *item, sl_err *err)
+{
+    static const char usage[] = "[[value, r, g, b, a], ...] or {\"colormap\": name, \"opacity\": [[t, alpha], ...], "
+                                "\"range\": [low, high]}";
+    sl_transfer_function tf;
+    memset(&tf, 0, sizeof tf);
+    const cJSON *points = item;
+    int width = 5;
+    tf.colormap = -1;
+    if (cJSON_IsObject(item)) {
+        width = 2;
+        for (const cJSON *k = item->child; k; k = k->next)
+            if (strcmp(k->string, "colormap") != 0 && strcmp(k->string, "opacity") != 0 && strcmp(k->string, "range") != 0)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': unknown key '%.40s' (takes %s)", name, k->string, usage);
+        const cJSON *cm = cJSON_GetObjectItemCaseSensitive(item, "colormap");
+        if (!cJSON_IsString(cm))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': \"colormap\" must be a colormap name (takes %s)", name, usage);
+        for (int k = 0; sl_colormap_names[k]; k++)
+            if (strcmp(sl_colormap_names[k], cm->valuestring) == 0)
+                tf.colormap = k;
+        if (tf.colormap < 0) {
+            char list[200] = "";
+            for (int k = 0; sl_colormap_names[k]; k++)
+                snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "", sl_colormap_names[k]);
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': no colormap '%.60s' (colormaps: %s)", name,
+                              cm->valuestring, list);
+        }
+        const cJSON *range = cJSON_GetObjectItemCaseSensitive(item, "range");
+        if (range) {
+            if (!cJSON_IsArray(range) || cJSON_GetArraySize(range) != 2 || !cJSON_IsNumber(cJSON_GetArrayItem(range, 0)) ||
+                !cJSON_IsNumber(cJSON_GetArrayItem(range, 1)))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': \"range\" must be [low, high] in data units", name);
+            tf.has_range = 1;
+            tf.range[0] = cJSON_GetArrayItem(range, 0)->valuedouble;
+            tf.range[1] = cJSON_GetArrayItem(range, 1)->valuedouble;
+        }
+        points = cJSON_GetObjectItemCaseSensitive(item, "opacity");
+        if (!points) {
+            tf.count = 2;
+            tf.point[1][0] = tf.point[1][1] = 1.0;
+            return sl_params_set_transfer(p, name, &tf, err);
+        }
+    }
+    if (!cJSON_IsArray(points))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes %s", name, usage);
+    int n = cJSON_GetArraySize(points);
+    if (n < 1 || n > SL_TF_MAX_POINTS)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes 1 to %d points, got %d", name, SL_TF_MAX_POINTS, n);
+    tf.count = n;
+    int k = 0;
+    for (const cJSON *pt = points->child; pt; pt = pt->next, k++) {
+        if (!cJSON_IsArray(pt) || cJSON_GetArraySize(pt) != width)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': point %d must be %s", name, k,
+                              width == 5 ? "[value, r, g, b, a]" : "[t, alpha]");
+        int c = 0;
+        for (const cJSON *e = pt->child; e; e = e->next, c++) {
+            if (!cJSON_IsNumber(e))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': point %d must be %s of numbers", name, k,
+                                  width == 5 ? "[value, r, g, b, a]" : "[t, alpha]");
+            tf.point[k][c] = e->valuedouble;
+        }
+    }
+    return sl_params_set_transfer(p, name, &tf, err);
+}
+
 static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
 {
     const char *name = item->string;
@@ -85,6 +156,8 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
             return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an attribute index in [%g, %g]%s", name,
                               d->min, d->max, d->min < 0 ? " (-1 = none)" : "");
         return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
+    case SL_PARAM_TRANSFER:
+        return apply_transfer(p, name, item, err);
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
         if (!cJSON_IsNumber(item))
@@ -110,9 +183,32 @@ sl_status sl_params_apply_json(sl_params *params, const cJSON *patch, sl_err *er
     return SL_OK;
 }
 
+static cJSON *transfer_json(const sl_transfer_function *tf)
+{
+    if (tf->colormap < 0) {
+        cJSON *a = cJSON_CreateArray();
+        for (int k = 0; a && k < tf->count; k++)
+            cJSON_AddItemToArray(a, cJSON_CreateDoubleArray(tf->point[k], 5));
+        return a;
+    }
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "colormap", sl_colormap_names[tf->colormap]);
+    cJSON *a = cJSON_AddArrayToObject(o, "opacity");
+    for (int k = 0; a && k < tf->count; k++)
+        cJSON_AddItemToArray(a, cJSON_CreateDoubleArray(tf->point[k], 2));
+    if (tf->has_range)
+        cJSON_AddItemToObject(o, "range", cJSON_CreateDoubleArray(tf->range, 2));
+    return o;
+}
+
 static cJSON *value_json(const sl_param_def *d, const double v[3])
 {
     switch (d->type) {
+    case SL_PARAM_TRANSFER: {
+        sl_transfer_function tf;
+        sl_transfer_function_default(d, &tf);
+        return transfer_json(&tf);
+    }
     case SL_PARAM_BOOL: return cJSON_CreateBool(v[0] != 0.0);
     case SL_PARAM_ENUM: return cJSON_CreateString(d->choices[(int)v[0]]);
     case SL_PARAM_VEC3: return cJSON_CreateDoubleArray(v, 3);
@@ -127,7 +223,9 @@ cJSON *sl_params_to_json(const sl_params *p)
 {
     cJSON *o = cJSON_CreateObject();
     for (int i = 0; o && i < p->count; i++)
-        cJSON_AddItemToObject(o, p->schema[i].name, value_json(&p->schema[i], p->value[i]));
+        cJSON_AddItemToObject(o, p->schema[i].name, p->schema[i].type == SL_PARAM_TRANSFER
+                                  ? transfer_json(&p->tf[(int)p->value[i][0]])
+                                  : value_json(&p->schema[i], p->value[i]));
     return o;
 }
 

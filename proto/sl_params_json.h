@@ -1,7 +1,9 @@
 /* sl_params_json.h — technique parameters to and from JSON.
  *
  * Values: numbers (float, int, attribute: an index, -1 = none), true/false
- * (bool), a choice name (enum), [x, y, z] (vec3). A patch is applied all-or-nothing: on the first unknown
+ * (bool), a choice name (enum), [x, y, z] (vec3), a transfer function as
+ * [[value, r, g, b, a], ...] or {"colormap", "opacity", "range"} (see
+ * sl_transfer_function in core/sl_params.h and PROTOCOL.md). A patch is applied all-or-nothing: on the first unknown
  * name, wrong type, out-of-range value or NaN, nothing changes and err names
  * the parameter and its allowed range. Any thread.
  */

@@ -176,6 +176,7 @@ static uint64_t scene_key(const sl_session_state *st)
     h = fnv1a(h, st->dataset_source, strlen(st->dataset_source) + 1);
     h = fnv1a(h, st->technique, strlen(st->technique) + 1);
     h = fnv1a(h, st->params.value, sizeof st->params.value[0] * (size_t)st->params.count);
+    h = fnv1a(h, st->params.tf, sizeof st->params.tf); /* transfer functions: unused entries are zero */
     h = fnv1a(h, &st->width, sizeof st->width);
     return fnv1a(h, &st->height, sizeof st->height);
 }

@@ -4,13 +4,14 @@
  * '{"generator":"tornado","lines":100}' or a built-in dataset name
  * (renderer/data/sl_generate.h), and prints one JSON object on stdout: kind,
  * name, counts, world bounds, origin, attributes with their ranges (lines) or
- * dims, voxel type, spacing and value range (volumes), and load_ms.
+ * dims, voxel type, spacing, value range and NaN voxels (volumes), and load_ms.
  * `sightline-info --list` prints the generator families and built-ins.
  * Does no loading or generating itself. Single-threaded.
  * Exit status: 0 success; 1 usage error (usage on stderr); 2 bad input, with
  * the reason on stderr and {"error", "status"} on stdout.
  */
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,7 +75,14 @@ static void add_volume(cJSON *root, const sl_volume *v)
     cJSON_AddStringToObject(root, "voxel_type", sl_voxel_type_name(v->type));
     cJSON_AddNumberToObject(root, "components", v->components);
     cJSON *counts = cJSON_AddObjectToObject(root, "counts");
-    cJSON_AddNumberToObject(counts, "voxels", (double)v->dims[0] * v->dims[1] * v->dims[2]);
+    size_t n = (size_t)v->dims[0] * v->dims[1] * v->dims[2];
+    cJSON_AddNumberToObject(counts, "voxels", (double)n);
+    /* NaN voxels (f32 only): the volume techniques draw them transparent. */
+    size_t nan = 0;
+    if (v->type == SL_VOXEL_F32)
+        for (size_t i = 0; i < n * (size_t)v->components; i++)
+            nan += isnan(((const float *)v->data)[i]);
+    cJSON_AddNumberToObject(counts, "nan_voxels", (double)nan);
     cJSON_AddItemToObject(root, "spacing", cJSON_CreateDoubleArray(v->spacing, 3));
     const double range[2] = {v->value_min, v->value_max};
     cJSON_AddItemToObject(root, "value_range", cJSON_CreateDoubleArray(range, 2));

@@ -307,6 +307,11 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
     cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
     cJSON_AddNumberToObject(s, "culled", last->render.culled);
     cJSON_AddNumberToObject(s, "dropped", last->render.dropped);
+    /* Ray marchers: samples evaluated and jumped over (empty-space skipping). */
+    double all = last->render.samples + last->render.samples_skipped;
+    cJSON_AddNumberToObject(s, "ray_samples", last->render.samples);
+    cJSON_AddNumberToObject(s, "ray_samples_skipped", last->render.samples_skipped);
+    cJSON_AddNumberToObject(s, "skipped_fraction", all > 0.0 ? last->render.samples_skipped / all : 0.0);
     char *out = cJSON_Print(s);
     cJSON_Delete(s);
     errno = 0;

@@ -5,14 +5,108 @@
 #include <math.h>
 #include <string.h>
 
+#include "sl_colormap.h"
+
 void sl_params_init(sl_params *p, const sl_param_def *schema, int count)
 {
     assert(count >= 0 && count <= SL_PARAMS_MAX);
     memset(p, 0, sizeof *p);
     p->schema = schema;
     p->count = count;
-    for (int i = 0; i < count; i++)
+    int slots = 0;
+    for (int i = 0; i < count; i++) {
+        if (schema[i].type == SL_PARAM_TRANSFER) {
+            assert(slots < SL_PARAMS_MAX_TF);
+            if (slots >= SL_PARAMS_MAX_TF)
+                continue;
+            p->value[i][0] = slots;
+            sl_transfer_function_default(&schema[i], &p->tf[slots++]);
+            continue;
+        }
         memcpy(p->value[i], schema[i].def, sizeof p->value[i]);
+    }
+}
+
+void sl_transfer_function_default(const sl_param_def *d, sl_transfer_function *out)
+{
+    memset(out, 0, sizeof *out);
+    out->colormap = (int)d->def[0];
+    out->count = 2;
+    out->point[0][0] = 0.0;
+    out->point[0][1] = d->def[1];
+    out->point[1][0] = 1.0;
+    out->point[1][1] = d->def[2];
+}
+
+static int colormap_count(void)
+{
+    int n = 0;
+    while (sl_colormap_names[n])
+        n++;
+    return n;
+}
+
+sl_status sl_transfer_function_check(const char *name, const sl_transfer_function *tf, sl_err *err)
+{
+    if (tf->colormap >= colormap_count())
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': no colormap %d (0 .. %d)", name, tf->colormap,
+                          colormap_count() - 1);
+    if (tf->count < 1 || tf->count > SL_TF_MAX_POINTS)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes 1 to %d points, got %d", name,
+                          SL_TF_MAX_POINTS, tf->count);
+    int colormap_form = tf->colormap >= 0;
+    if (colormap_form && tf->has_range &&
+        !(isfinite(tf->range[0]) && isfinite(tf->range[1]) && tf->range[0] < tf->range[1]))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': range [%g, %g] must be two finite values, low < high",
+                          name, tf->range[0], tf->range[1]);
+    static const char *const field[5] = {"value", "red", "green", "blue", "alpha"};
+    static const char *const ramp_field[2] = {"t", "alpha"};
+    int n = colormap_form ? 2 : 5;
+    for (int k = 0; k < tf->count; k++) {
+        const double *pt = tf->point[k];
+        for (int c = 0; c < n; c++) {
+            const char *what = colormap_form ? ramp_field[c] : field[c];
+            int is_value = !colormap_form && c == 0;
+            if (!isfinite(pt[c]))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': point %d: %s is %g, must be finite", name,
+                                  k, what, pt[c]);
+            if (!is_value && (pt[c] < 0.0 || pt[c] > 1.0))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': point %d: %s %g is outside [0, 1]", name, k,
+                                  what, pt[c]);
+        }
+        if (k > 0 && pt[0] < tf->point[k - 1][0])
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': point %d: %s %g is below point %d's %g "
+                              "(points are sorted by %s)", name, k, colormap_form ? "t" : "value", pt[0], k - 1,
+                              tf->point[k - 1][0], colormap_form ? "t" : "value");
+    }
+    return SL_OK;
+}
+
+sl_status sl_params_set_transfer(sl_params *p, const char *name, const sl_transfer_function *tf, sl_err *err)
+{
+    int i = sl_params_find(p, name);
+    if (i < 0)
+        return sl_err_set(err, SL_ERR_INVALID, "unknown parameter '%s'", name);
+    if (p->schema[i].type != SL_PARAM_TRANSFER)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes no transfer function", name,
+                          sl_param_type_name(p->schema[i].type));
+    sl_status st = sl_transfer_function_check(name, tf, err);
+    if (st != SL_OK)
+        return st;
+    /* Stored with unused entries zeroed, so equal functions compare equal. */
+    sl_transfer_function clean;
+    memset(&clean, 0, sizeof clean);
+    clean.colormap = tf->colormap < 0 ? -1 : tf->colormap;
+    clean.count = tf->count;
+    clean.has_range = clean.colormap >= 0 && tf->has_range;
+    if (clean.has_range)
+        memcpy(clean.range, tf->range, sizeof clean.range);
+    int n = clean.colormap >= 0 ? 2 : 5;
+    for (int k = 0; k < tf->count; k++)
+        for (int c = 0; c < n; c++)
+            clean.point[k][c] = tf->point[k][c] == 0.0 ? 0.0 : tf->point[k][c]; /* -0 -> 0 */
+    p->tf[(int)p->value[i][0]] = clean;
+    return SL_OK;
 }
 
 int sl_params_find(const sl_params *p, const char *name)
@@ -53,6 +147,9 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
     if (i < 0)
         return unknown_parameter(p, name, err);
     const sl_param_def *d = &p->schema[i];
+    if (d->type == SL_PARAM_TRANSFER)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (transfer_function) takes control points "
+                          "[[value, r, g, b, a], ...] or {\"colormap\": name, \"opacity\": [[t, a], ...]}, not numbers", name);
     int want = d->type == SL_PARAM_VEC3 ? 3 : 1;
     if (n != want)
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes %d number%s, got %d",
@@ -83,6 +180,7 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
                 return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer in [%g, %g], got %g",
                                   name, d->min, d->max, v[k]);
             /* fall through */
+        case SL_PARAM_TRANSFER: /* refused above */
         case SL_PARAM_FLOAT:
         case SL_PARAM_VEC3:
             if (v[k] < d->min || v[k] > d->max)
@@ -189,14 +287,31 @@ void sl_params_vec3(const sl_params *p, const char *name, float out[3])
         out[k] = i < 0 ? 0.0f : (float)p->value[i][k];
 }
 
+const sl_transfer_function *sl_params_transfer(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_TRANSFER);
+    return i < 0 ? &p->tf[0] : &p->tf[(int)p->value[i][0]];
+}
+
+/* Equal transfer functions: field by field (no padding compared). */
+static int same_transfer(const sl_transfer_function *a, const sl_transfer_function *b)
+{
+    return a->colormap == b->colormap && a->count == b->count && a->has_range == b->has_range &&
+           memcmp(a->range, b->range, sizeof a->range) == 0 && memcmp(a->point, b->point, sizeof a->point) == 0;
+}
+
 sl_invalidation sl_params_compare(const sl_params *a, const sl_params *b)
 {
     if (a->schema != b->schema || a->count != b->count)
         return SL_INVALIDATE_PREPARED;
     sl_invalidation level = SL_INVALIDATE_NONE;
-    for (int i = 0; i < a->count; i++)
-        if (memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0 && a->schema[i].invalidates > level)
+    for (int i = 0; i < a->count; i++) {
+        int differs = memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0;
+        if (!differs && a->schema[i].type == SL_PARAM_TRANSFER)
+            differs = !same_transfer(&a->tf[(int)a->value[i][0]], &b->tf[(int)b->value[i][0]]);
+        if (differs && a->schema[i].invalidates > level)
             level = a->schema[i].invalidates;
+    }
     return level;
 }
 
@@ -209,6 +324,7 @@ const char *sl_param_type_name(sl_param_type t)
     case SL_PARAM_ENUM: return "enum";
     case SL_PARAM_VEC3: return "vec3";
     case SL_PARAM_ATTRIBUTE: return "attribute";
+    case SL_PARAM_TRANSFER: return "transfer_function";
     }
     return "unknown";
 }

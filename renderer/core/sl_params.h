@@ -26,7 +26,31 @@ typedef enum sl_param_type {
                            integer in [min, max]; min is -1 (then -1 = none) or 0.
                            The schema bounds every dataset; sl_params_check_attributes
                            narrows it to the dataset's count. Given as a number. */
+    SL_PARAM_TRANSFER,  /* a transfer function (sl_transfer_function below); min/max
+                           unused; default: def[0] = colormap index, opacity ramp
+                           from def[1] at t = 0 to def[2] at t = 1 over the
+                           dataset's value range. Set with sl_params_set_transfer. */
 } sl_param_type;
+
+/* A transfer function as given, in one of two forms (renderer/volume/
+ * resolves either to control points for a dataset):
+ *   points:   colormap < 0; point[k] = {value, r, g, b, a}, value in data
+ *             units (non-decreasing), colour and opacity in [0, 1];
+ *             piecewise linear, constant beyond the first and last point.
+ *   colormap: colormap >= 0 (index into sl_colormap_names); point[k] =
+ *             {t, alpha} (t in [0, 1], non-decreasing) an opacity ramp;
+ *             t = 0 and 1 are range[0] and range[1] in data units when
+ *             has_range, else the dataset's value range.
+ * Unused entries are zero, so two equal functions compare equal bytewise. */
+#define SL_TF_MAX_POINTS 64
+#define SL_PARAMS_MAX_TF 2 /* transfer-function parameters per schema */
+typedef struct sl_transfer_function {
+    int colormap;
+    int count;                      /* 1 .. SL_TF_MAX_POINTS */
+    int has_range;
+    double range[2];                /* colormap form with has_range: range[0] < range[1] */
+    double point[SL_TF_MAX_POINTS][5];
+} sl_transfer_function;
 
 /* Ordered: a larger level implies every smaller one. */
 typedef enum sl_invalidation {
@@ -50,10 +74,12 @@ typedef struct sl_param_def {
 typedef struct sl_params {
     const sl_param_def *schema; /* borrowed, static */
     int count;
-    double value[SL_PARAMS_MAX][3];
+    double value[SL_PARAMS_MAX][3]; /* SL_PARAM_TRANSFER: value[i][0] = its slot in tf */
+    sl_transfer_function tf[SL_PARAMS_MAX_TF];
 } sl_params;
 
-/* Sets every value to its schema default. count must be <= SL_PARAMS_MAX. */
+/* Sets every value to its schema default. count must be <= SL_PARAMS_MAX,
+ * with at most SL_PARAMS_MAX_TF transfer-function entries. */
 void sl_params_init(sl_params *p, const sl_param_def *schema, int count);
 
 /* Index of the named parameter, or -1. */
@@ -65,6 +91,15 @@ int sl_params_find(const sl_params *p, const char *name);
 sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v, int n, sl_err *err);
 sl_status sl_params_set_choice(sl_params *p, const char *name, const char *choice, sl_err *err);
 
+/* Checked setter of a SL_PARAM_TRANSFER parameter: on failure nothing
+ * changes and err names the parameter and the bad point ("point 3 ...")
+ * with what is wrong and the allowed range. */
+sl_status sl_params_set_transfer(sl_params *p, const char *name, const sl_transfer_function *tf, sl_err *err);
+/* The schema default of a SL_PARAM_TRANSFER entry (see sl_param_type). */
+void sl_transfer_function_default(const sl_param_def *d, sl_transfer_function *out);
+/* Validates tf alone; err names `name` and the bad point. */
+sl_status sl_transfer_function_check(const char *name, const sl_transfer_function *tf, sl_err *err);
+
 /* Getters for techniques; the name must exist in the schema with that type
  * (a programmer error otherwise: asserts, then returns 0). */
 double sl_params_float(const sl_params *p, const char *name);
@@ -74,6 +109,7 @@ int sl_params_attribute(const sl_params *p, const char *name);    /* attribute i
 int sl_params_choice(const sl_params *p, const char *name);       /* enum index */
 const char *sl_params_choice_name(const sl_params *p, const char *name);
 void sl_params_vec3(const sl_params *p, const char *name, float out[3]);
+const sl_transfer_function *sl_params_transfer(const sl_params *p, const char *name); /* borrowed from p */
 
 /* Checks every SL_PARAM_ATTRIBUTE value against a dataset with `count`
  * per-vertex attributes: SL_OK when each is -1, below count, or its schema

@@ -8,12 +8,14 @@ extern const sl_technique sl_tubes_mesh_technique;
 extern const sl_technique sl_tubes_technique;
 extern const sl_technique sl_voxel_lines_technique;
 extern const sl_technique sl_lines_oit_technique;
+extern const sl_technique sl_volume_dvr_technique;
 
 static const sl_technique *const techniques[] = {
     &sl_tubes_mesh_technique,
     &sl_tubes_technique,
     &sl_voxel_lines_technique,
     &sl_lines_oit_technique,
+    &sl_volume_dvr_technique,
 };
 
 const sl_technique *const *sl_technique_list(int *count)

@@ -38,6 +38,8 @@ typedef struct sl_render_stats {
     double culled;           /* primitives skipped by culling */
     double dropped;          /* pieces of data the technique could not draw
                                 (voxel_lines: lines beyond the per-voxel cap) */
+    double samples;          /* ray marchers: samples evaluated */
+    double samples_skipped;  /* ray marchers: samples jumped over by empty-space skipping */
 } sl_render_stats;
 
 /* Where the time of the last prepare went (fill what applies; zero is fine).

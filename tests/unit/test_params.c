@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/sl_colormap.h"
 #include "core/sl_params.h"
 #include "core/sl_technique.h"
 #include "sl_params_json.h"
@@ -41,7 +42,9 @@ static int is_numeric(const sl_param_def *d)
 
 static int same_values(const sl_params *a, const sl_params *b)
 {
-    return a->count == b->count && memcmp(a->value, b->value, sizeof a->value) == 0;
+    /* compare also sees transfer functions (kept apart from value[]). */
+    return a->count == b->count && memcmp(a->value, b->value, sizeof a->value) == 0 &&
+           sl_params_compare(a, b) == SL_INVALIDATE_NONE;
 }
 
 /* Does the message name the parameter and its allowed range (or its choices)? */
@@ -69,6 +72,8 @@ static int names_range(const char *msg, const sl_param_def *d)
         snprintf(range, sizeof range, "[0, %d]", choice_count(d) - 1);
         return all || strstr(msg, range) != NULL;
     }
+    case SL_PARAM_TRANSFER:
+        return strstr(msg, "point") != NULL || strstr(msg, "[[value, r, g, b, a], ...]") != NULL;
     }
     return 0;
 }
@@ -151,6 +156,8 @@ static cJSON *other_value(const sl_param_def *d, double out[3])
         out[0] = ((int)d->def[0] + 1) % n;
         return cJSON_CreateString(d->choices[(int)out[0]]);
     }
+    case SL_PARAM_TRANSFER: /* test_transfer_parameter */
+        return NULL;
     }
     return NULL;
 }
@@ -203,13 +210,109 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
         for (int k = 0; def_ok && k < 3; k++)
             def_ok = cJSON_GetArrayItem(def, k)->valuedouble == d->def[k];
         break;
+    case SL_PARAM_TRANSFER: {
+        /* {"colormap": choices[def[0]], "opacity": [[0, def[1]], [1, def[2]]]} */
+        const cJSON *cm = cJSON_GetObjectItemCaseSensitive(def, "colormap");
+        const cJSON *op = cJSON_GetObjectItemCaseSensitive(def, "opacity");
+        def_ok = cJSON_IsString(cm) && strcmp(cm->valuestring, sl_colormap_names[(int)d->def[0]]) == 0 &&
+                 cJSON_GetArraySize(op) == 2 &&
+                 cJSON_GetArrayItem(cJSON_GetArrayItem(op, 0), 1)->valuedouble == d->def[1] &&
+                 cJSON_GetArrayItem(cJSON_GetArrayItem(op, 1), 1)->valuedouble == d->def[2];
+        break;
+    }
     }
     SL_CHECK_MSG(def_ok, "%s.%s: schema JSON default", tech, d->name);
+}
+
+/* Applies the JSON text to a copy of base for a transfer-function parameter;
+ * expects it refused with a message holding every `needles` (NULL-ended)
+ * and nothing changed. */
+static void expect_tf_refused(const sl_params *base, const sl_param_def *d, const char *json, const char *const *needles)
+{
+    sl_params p = *base;
+    sl_err err = {0};
+    cJSON *item = cJSON_Parse(json);
+    SL_CHECK_MSG(item != NULL, "bad test JSON %s", json);
+    sl_status st = apply_one(&p, d->name, item, &err);
+    SL_CHECK_MSG(st == SL_ERR_INVALID, "%s = %s was accepted", d->name, json);
+    char name[80];
+    snprintf(name, sizeof name, "'%s'", d->name);
+    SL_CHECK_MSG(strstr(err.message, name) != NULL, "%s = %s: message '%s' does not name it", d->name, json, err.message);
+    for (int k = 0; needles[k]; k++)
+        SL_CHECK_MSG(strstr(err.message, needles[k]) != NULL, "%s = %s: message '%s' lacks '%s'", d->name, json,
+                     err.message, needles[k]);
+    SL_CHECK_MSG(same_values(&p, base), "%s = %s: a refused patch changed values", d->name, json);
+}
+
+/* A SL_PARAM_TRANSFER parameter: both JSON forms apply, round-trip through
+ * sl_params_to_json and report the declared level; each kind of bad point
+ * is refused naming the point. */
+static void test_transfer_parameter(const sl_technique *t, int i)
+{
+    const sl_param_def *d = &t->params[i];
+    sl_params base;
+    sl_params_init(&base, t->params, t->param_count);
+    sl_err err = {0};
+    const sl_transfer_function *def = sl_params_transfer(&base, d->name);
+    SL_CHECK_MSG(def->colormap == (int)d->def[0] && def->count == 2 && def->point[1][1] == d->def[2],
+                 "%s.%s: default", t->name, d->name);
+    SL_CHECK(sl_transfer_function_check(d->name, def, &err) == SL_OK);
+    const char *good[] = {"[[0, 0, 0, 0, 0], [0.5, 1, 0.5, 0.25, 0.1], [2, 1, 1, 1, 1]]",
+                          "{\"colormap\": \"magma\", \"opacity\": [[0, 0], [0.5, 0.2], [1, 1]], \"range\": [-1, 2]}",
+                          "{\"colormap\": \"gray\"}", "[[3, 1, 0, 0, 0.5]]"};
+    for (int g = 0; g < 4; g++) {
+        sl_params p = base;
+        cJSON *item = cJSON_Parse(good[g]);
+        sl_status st = apply_one(&p, d->name, item, &err);
+        SL_CHECK_MSG(st == SL_OK, "%s.%s = %s: %s", t->name, d->name, good[g], err.message);
+        SL_CHECK_MSG(sl_params_compare(&base, &p) == d->invalidates, "%s.%s = %s: compare", t->name, d->name, good[g]);
+        cJSON *all = sl_params_to_json(&p);
+        sl_params q = base;
+        SL_CHECK_MSG(all && sl_params_apply_json(&q, all, &err) == SL_OK && same_values(&q, &p),
+                     "%s.%s = %s: no round trip", t->name, d->name, good[g]);
+        cJSON_Delete(all);
+    }
+    sl_params p = base;
+    cJSON *item = cJSON_Parse(good[0]);
+    SL_CHECK(apply_one(&p, d->name, item, &err) == SL_OK);
+    const sl_transfer_function *tf = sl_params_transfer(&p, d->name);
+    SL_CHECK(tf->colormap == -1 && tf->count == 3 && tf->point[1][0] == 0.5 && tf->point[1][3] == 0.25 &&
+             tf->point[2][4] == 1.0);
+
+    expect_tf_refused(&base, d, "[[0, 0, 0, 0, 0], [1, 1, 1, 1, 1.5]]", (const char *[]){"point 1", "alpha", "[0, 1]", NULL});
+    expect_tf_refused(&base, d, "[[0, 0, 0, 0, 0], [1, 1, 1, 1, 1], [0.5, 0, 0, 0, 0]]",
+                      (const char *[]){"point 2", "below point 1", NULL});
+    expect_tf_refused(&base, d, "[[0, -0.1, 0, 0, 0]]", (const char *[]){"point 0", "red", NULL});
+    expect_tf_refused(&base, d, "[[0, 0, 0, 0]]", (const char *[]){"point 0", "[value, r, g, b, a]", NULL});
+    expect_tf_refused(&base, d, "[[0, 0, 0, 0, 0], [1, 1, \"x\", 1, 1]]", (const char *[]){"point 1", NULL});
+    expect_tf_refused(&base, d, "[]", (const char *[]){"1 to 64", NULL});
+    expect_tf_refused(&base, d, "[[1e400, 0, 0, 0, 0]]", (const char *[]){"point 0", "finite", NULL});
+    expect_tf_refused(&base, d, "\"viridis\"", (const char *[]){"[[value, r, g, b, a], ...]", NULL});
+    expect_tf_refused(&base, d, "3", (const char *[]){"[[value, r, g, b, a], ...]", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"nope\"}", (const char *[]){"nope", "viridis", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"range\": [1, 1]}", (const char *[]){"range", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"opacity\": [[0.5, 0], [0.2, 1]]}",
+                      (const char *[]){"point 1", "t 0.2", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"opacity\": [[0, 2]]}",
+                      (const char *[]){"point 0", "alpha", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"ramp\": []}", (const char *[]){"ramp", NULL});
+    char many[4096] = "[";
+    for (int k = 0; k < SL_TF_MAX_POINTS + 1; k++)
+        snprintf(many + strlen(many), sizeof many - strlen(many), "%s[%d, 0, 0, 0, 0]", k ? "," : "", k);
+    strcat(many, "]");
+    expect_tf_refused(&base, d, many, (const char *[]){"1 to 64", "65", NULL});
+    /* Numbers are refused by the number setter too. */
+    sl_params q = base;
+    SL_CHECK(sl_params_set_numbers(&q, d->name, d->def, 1, &err) == SL_ERR_INVALID && strstr(err.message, d->name));
 }
 
 static void test_parameter(const sl_technique *t, int i)
 {
     const sl_param_def *d = &t->params[i];
+    if (d->type == SL_PARAM_TRANSFER) {
+        test_transfer_parameter(t, i);
+        return;
+    }
     sl_params base;
     sl_params_init(&base, t->params, t->param_count);
     sl_err err = {0};
@@ -243,6 +346,8 @@ static void test_parameter(const sl_technique *t, int i)
     case SL_PARAM_ENUM:
         in_range &= choice_count(d) >= 1 && d->def[0] == floor(d->def[0]) && d->def[0] >= 0 &&
                     d->def[0] < choice_count(d);
+        break;
+    case SL_PARAM_TRANSFER: /* test_transfer_parameter */
         break;
     }
     SL_CHECK_MSG(in_range, "%s.%s: default out of its own range", t->name, d->name);
@@ -349,6 +454,8 @@ static void test_parameter(const sl_technique *t, int i)
         expect_refused(&base, d, mixed, "a string component");
         break;
     }
+    case SL_PARAM_TRANSFER: /* test_transfer_parameter */
+        break;
     }
 
     /* All-or-nothing: a valid change followed by a bad one changes nothing. */

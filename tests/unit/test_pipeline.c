@@ -111,6 +111,13 @@ static int move_param(sl_params *p, int i, sl_err *err)
         v[0] = moved_number(d, v[0]);
         n = 3;
         break;
+    case SL_PARAM_TRANSFER: {
+        /* Another opacity at the last point of the ramp or point list. */
+        sl_transfer_function tf = *sl_params_transfer(p, d->name);
+        int last = tf.count - 1, alpha = tf.colormap >= 0 ? 1 : 4;
+        tf.point[last][alpha] = tf.point[last][alpha] > 0.5 ? 0.25 : 0.75;
+        return sl_params_set_transfer(p, d->name, &tf, err) == SL_OK;
+    }
     }
     return sl_params_set_numbers(p, d->name, v, n, err) == SL_OK;
 }

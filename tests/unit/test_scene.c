@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "data/sl_dataset.h"
+#include "sl_params_json.h"
 #include "sl_scene.h"
 #include "sl_test.h"
 
@@ -174,13 +175,22 @@ static void test_valid(void)
         sl_scene_deinit(&s);
     }
 
-    /* Every registered technique is accepted, with valid params of its own. */
+    /* Every registered technique is accepted, with valid params of its own:
+     * every parameter at its default, as sl_params_to_json writes it (a
+     * volume technique has no `radius`). */
     int n = 0;
     const sl_technique *const *list = sl_technique_list(&n);
     for (int k = 0; k < n; k++) {
-        snprintf(text, sizeof text, "{\"dataset\": \"x.vtk\", \"technique\": \"%s\", \"params\": {\"radius\": 0.5}}",
-                 list[k]->name);
-        if (parse_ok(text, &s)) {
+        sl_params defaults;
+        sl_params_init(&defaults, list[k]->params, list[k]->param_count);
+        cJSON *pj = sl_params_to_json(&defaults);
+        char *ptext = pj ? cJSON_PrintUnformatted(pj) : NULL;
+        cJSON_Delete(pj);
+        char big[8192];
+        snprintf(big, sizeof big, "{\"dataset\": \"x.vtk\", \"technique\": \"%s\", \"params\": %s}", list[k]->name,
+                 ptext ? ptext : "{}");
+        cJSON_free(ptext);
+        if (parse_ok(big, &s)) {
             SL_CHECK(strcmp(s.technique, list[k]->name) == 0);
             sl_scene_deinit(&s);
         }

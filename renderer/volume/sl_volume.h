@@ -1,0 +1,142 @@
+/* sl_volume.h — shared preparation of scalar volumes for the volume techniques.
+ *
+ * What volume_dvr uses and particles / lr_volume are meant to reuse: the
+ * volume's geometry (values at voxel centres, the box spanning them), its 3D
+ * texture (every voxel type, exact data values), the transfer function
+ * resolved for a dataset and baked into a small 1D texture, and the min-max
+ * brick grid with a per-transfer-function "visible bricks" mask. GLSL halves:
+ * volume/volume_ray.glsl (ray–box + clip box), volume/volume_sample.glsl
+ * (values), volume/volume_tf.glsl (lookup + opacity correction).
+ * Invariants: the min-max grid is built once per volume; a new transfer
+ * function re-bakes the TF texture and rebuilds the mask from that grid only
+ * (counted in sl_volume_counters). Vector fields are drawn by magnitude.
+ * Not here: ray marching, shading, techniques' parameters. GL functions run
+ * on the render thread; the CPU functions (resolve, bake, mask) on any.
+ */
+#ifndef SL_VOLUME_H
+#define SL_VOLUME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <epoxy/gl.h>
+
+#include "../core/sl_params.h"
+#include "../data/sl_dataset.h"
+
+/* Geometry: voxel (i,j,k) sits at origin + spacing·(i,j,k); the box spans
+ * the voxel centres, [0, dims-1] per axis in voxel coordinates — except an
+ * axis with one voxel, which gets a slab one spacing thick centred on it,
+ * [-0.5, 0.5] (the value is constant across it), so 1×1×N and N×N×1
+ * volumes are visible. World = origin + spacing · voxel coordinate. */
+typedef struct sl_volume_geometry {
+    int dims[3];
+    double spacing[3];
+    double min_spacing;       /* the unit of `step` (step_ref = 1) */
+    sl_vec3 origin;           /* world of voxel (0,0,0) */
+    double box_lo[3], box_hi[3]; /* voxel coordinates */
+} sl_volume_geometry;
+
+void sl_volume_geometry_init(const sl_dataset *ds, sl_volume_geometry *g);
+
+/* The volume as a 3D texture: texel (i,j,k) holds voxel (i,j,k); the data
+ * value is texel · value_scale + value_offset (u8 as R8, u16 as R16, s16 as
+ * R16 after adding 32768 so every value is exact, f32 as R32F with NaN kept;
+ * vector fields as the R32F magnitude). Clamp to edge; linear or nearest. */
+typedef struct sl_volume_texture {
+    GLuint tex;
+    float value_scale, value_offset;
+    size_t bytes;
+} sl_volume_texture;
+
+/* SL_ERR_UNSUPPORTED above GL_MAX_3D_TEXTURE_SIZE, SL_ERR_NOMEM, SL_ERR_GPU
+ * (sl_gl_check_errors). On failure *t is zeroed and nothing is held. */
+sl_status sl_volume_texture_create(const sl_volume *vol, sl_volume_texture *t, sl_err *err);
+void sl_volume_texture_destroy(sl_volume_texture *t); /* zeroed is fine */
+void sl_volume_texture_set_filter(const sl_volume_texture *t, int linear);
+
+/* A precomputed gradient: per voxel the central difference of the voxel
+ * values (one-sided at the edges, divided by the spacing: world units),
+ * normalized and stored as RGBA8_SNORM (xyz; zero where the difference is
+ * zero or touches NaN), filtered linearly. For shading only (direction).
+ * SL_ERR_NOMEM, SL_ERR_GPU; on failure *tex is 0. Counted as a gradient build. */
+sl_status sl_volume_gradient_create(const sl_volume *vol, GLuint *tex, size_t *bytes, sl_err *err);
+
+/* A transfer function resolved for a dataset: control points in data units,
+ * piecewise linear, constant beyond the ends. The colormap form becomes the
+ * union of the colormap's own control points and the opacity ramp's (exact:
+ * both are piecewise linear in t). A range of one value (constant volume)
+ * is widened to [v - 0.5, v + 0.5]. */
+#define SL_VOLUME_TF_MAX (SL_TF_MAX_POINTS + 16)
+typedef struct sl_volume_tf_points {
+    int count;
+    double value[SL_VOLUME_TF_MAX];
+    double rgba[SL_VOLUME_TF_MAX][4];
+} sl_volume_tf_points;
+
+void sl_volume_tf_resolve(const sl_transfer_function *tf, double value_min, double value_max,
+                          sl_volume_tf_points *out);
+/* rgba at value v (NaN: transparent black). */
+void sl_volume_tf_eval(const sl_volume_tf_points *pts, double v, double rgba[4]);
+
+/* The baked table: SL_VOLUME_TF_TEXELS texels, texel k = the function at
+ * lo + k (hi - lo) / (TEXELS - 1); the shader interpolates linearly between
+ * two texels (volume_tf.glsl), clamping beyond the ends. lo = first point,
+ * hi = last (hi = lo + 1 when they coincide). */
+#define SL_VOLUME_TF_TEXELS 4096
+typedef struct sl_volume_tf_table {
+    double lo, hi;
+    float rgba[SL_VOLUME_TF_TEXELS][4];
+    uint32_t nonzero_before[SL_VOLUME_TF_TEXELS + 1]; /* texels < k with alpha > 0 */
+} sl_volume_tf_table;
+
+void sl_volume_tf_bake(const sl_volume_tf_points *pts, sl_volume_tf_table *table);
+/* 1 when the baked function has alpha > 0 anywhere in [lo, hi] (as the
+ * shader interpolates it: every texel the interval touches). */
+int sl_volume_tf_table_visible(const sl_volume_tf_table *table, double lo, double hi);
+
+/* The TF texture: a 1D RGBA32F texture of SL_VOLUME_TF_TEXELS (create once,
+ * upload per change). */
+sl_status sl_volume_tf_texture_create(GLuint *tex, sl_err *err);
+void sl_volume_tf_texture_upload(GLuint tex, const sl_volume_tf_table *table);
+
+/* Min-max bricks: brick b covers the voxels [B b, B b + B] of each axis
+ * (one voxel of overlap: a trilinear sample anywhere in the brick reads
+ * only these), min and max of their finite values (min > max: none). */
+#define SL_VOLUME_BRICK 8
+typedef struct sl_volume_bricks {
+    int dims[3];              /* bricks per axis */
+    float *minmax;            /* 2 per brick, x fastest; owned */
+    uint8_t *mask;            /* 1 per brick: 1 = visible; owned */
+    GLuint minmax_tex;        /* RG32F */
+    GLuint mask_tex;          /* R8UI */
+    size_t bytes;             /* GPU bytes */
+} sl_volume_bricks;
+
+/* Builds the min-max grid (CPU, once) and both textures; mask all visible.
+ * SL_ERR_NOMEM, SL_ERR_GPU. On failure nothing is held. */
+sl_status sl_volume_bricks_create(const sl_volume *vol, sl_volume_bricks *b, sl_err *err);
+void sl_volume_bricks_destroy(sl_volume_bricks *b); /* zeroed is fine */
+
+typedef enum sl_volume_mask_rule {
+    SL_VOLUME_MASK_TF,        /* visible where the baked TF has alpha > 0 on [min, max] */
+    SL_VOLUME_MASK_ISO,       /* visible where min <= iso <= max */
+    SL_VOLUME_MASK_FINITE,    /* visible where the brick has a finite value */
+} sl_volume_mask_rule;
+/* Rebuilds the mask from the min-max grid (never rebuilds the grid) and
+ * uploads it; returns the number of visible bricks. */
+size_t sl_volume_bricks_update_mask(sl_volume_bricks *b, sl_volume_mask_rule rule, const sl_volume_tf_table *table,
+                                    double iso);
+
+/* Work counters: process-wide totals, never reset (compare two readings).
+ * Render thread only, unlocked. */
+typedef struct sl_volume_counters {
+    unsigned long texture_uploads;   /* 3D volume textures created */
+    unsigned long minmax_builds;     /* min-max grids built */
+    unsigned long mask_builds;       /* visible-brick masks rebuilt and uploaded */
+    unsigned long tf_uploads;        /* TF textures uploaded */
+    unsigned long gradient_builds;   /* precomputed gradient textures built */
+} sl_volume_counters;
+void sl_volume_get_counters(sl_volume_counters *out);
+
+#endif

@@ -1,0 +1,158 @@
+/* volume_tf.c — a transfer-function parameter resolved for a dataset, baked, uploaded (see sl_volume.h).
+ *
+ * Resolution is exact (the colormap form's colormap and opacity ramp are both
+ * piecewise linear in t, so their union of breakpoints reproduces them); the
+ * bake samples the result at SL_VOLUME_TF_TEXELS evenly spaced values, so
+ * only texels holding a breakpoint differ from the exact function (by at most
+ * a slope change × 1/4 texel). CPU parts: any thread; GL parts: render thread.
+ */
+#include "sl_volume.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/sl_colormap.h"
+#include "../gpu/sl_gpu.h"
+
+extern sl_volume_counters sl_volume_counters_now; /* volume_bricks.c */
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Opacity of a [t, alpha] ramp at t (constant beyond the ends). */
+static double ramp_alpha(const sl_transfer_function *tf, double t)
+{
+    if (t <= tf->point[0][0])
+        return tf->point[0][1];
+    for (int k = 1; k < tf->count; k++)
+        if (t <= tf->point[k][0]) {
+            double t0 = tf->point[k - 1][0], t1 = tf->point[k][0];
+            double f = t1 > t0 ? (t - t0) / (t1 - t0) : 1.0;
+            return tf->point[k - 1][1] + f * (tf->point[k][1] - tf->point[k - 1][1]);
+        }
+    return tf->point[tf->count - 1][1];
+}
+
+void sl_volume_tf_resolve(const sl_transfer_function *tf, double value_min, double value_max,
+                          sl_volume_tf_points *out)
+{
+    memset(out, 0, sizeof *out);
+    if (tf->colormap < 0) {
+        out->count = tf->count;
+        for (int k = 0; k < tf->count; k++) {
+            out->value[k] = tf->point[k][0];
+            for (int c = 0; c < 4; c++)
+                out->rgba[k][c] = tf->point[k][1 + c];
+        }
+        return;
+    }
+    double lo = tf->has_range ? tf->range[0] : value_min, hi = tf->has_range ? tf->range[1] : value_max;
+    if (!(hi > lo)) {
+        lo -= 0.5;
+        hi = lo + 1.0;
+    }
+    /* Breakpoints in t: the colormap's 9 control points and the ramp's. */
+    double ts[SL_VOLUME_TF_MAX];
+    int n = 0;
+    for (int k = 0; k <= 8; k++)
+        ts[n++] = k / 8.0;
+    for (int k = 0; k < tf->count; k++)
+        ts[n++] = fmin(fmax(tf->point[k][0], 0.0), 1.0);
+    qsort(ts, (size_t)n, sizeof ts[0], compare_doubles);
+    for (int k = 0; k < n; k++) {
+        if (out->count > 0 && ts[k] == ts[k - 1])
+            continue;
+        float rgb[3];
+        sl_colormap_sample(tf->colormap, ts[k], rgb);
+        int i = out->count++;
+        out->value[i] = lo + ts[k] * (hi - lo);
+        out->rgba[i][0] = rgb[0];
+        out->rgba[i][1] = rgb[1];
+        out->rgba[i][2] = rgb[2];
+        out->rgba[i][3] = ramp_alpha(tf, ts[k]);
+    }
+}
+
+void sl_volume_tf_eval(const sl_volume_tf_points *pts, double v, double rgba[4])
+{
+    if (isnan(v)) {
+        rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0;
+        return;
+    }
+    int n = pts->count;
+    const double *a = pts->rgba[0], *b = pts->rgba[n - 1];
+    double f = 0.0;
+    if (v > pts->value[0] && v < pts->value[n - 1]) {
+        for (int k = 1; k < n; k++)
+            if (v <= pts->value[k]) {
+                double v0 = pts->value[k - 1], v1 = pts->value[k];
+                a = pts->rgba[k - 1];
+                b = pts->rgba[k];
+                f = v1 > v0 ? (v - v0) / (v1 - v0) : 1.0;
+                break;
+            }
+    } else if (v >= pts->value[n - 1]) {
+        a = b;
+    }
+    for (int c = 0; c < 4; c++)
+        rgba[c] = a[c] + f * (b[c] - a[c]);
+}
+
+void sl_volume_tf_bake(const sl_volume_tf_points *pts, sl_volume_tf_table *table)
+{
+    table->lo = pts->value[0];
+    table->hi = pts->value[pts->count - 1];
+    if (!(table->hi > table->lo))
+        table->hi = table->lo + 1.0;
+    uint32_t nonzero = 0;
+    for (int k = 0; k < SL_VOLUME_TF_TEXELS; k++) {
+        double v = table->lo + (table->hi - table->lo) * k / (SL_VOLUME_TF_TEXELS - 1);
+        double rgba[4];
+        sl_volume_tf_eval(pts, v, rgba);
+        for (int c = 0; c < 4; c++)
+            table->rgba[k][c] = (float)rgba[c];
+        table->nonzero_before[k] = nonzero;
+        nonzero += table->rgba[k][3] > 0.0f;
+    }
+    table->nonzero_before[SL_VOLUME_TF_TEXELS] = nonzero;
+}
+
+/* Texel coordinate of value v, clamped to [0, TEXELS - 1]. */
+static double texel_of(const sl_volume_tf_table *t, double v)
+{
+    double u = (v - t->lo) / (t->hi - t->lo) * (SL_VOLUME_TF_TEXELS - 1);
+    return u < 0.0 ? 0.0 : (u > SL_VOLUME_TF_TEXELS - 1 ? SL_VOLUME_TF_TEXELS - 1 : u);
+}
+
+int sl_volume_tf_table_visible(const sl_volume_tf_table *table, double lo, double hi)
+{
+    if (!(lo <= hi))
+        return 0;
+    /* A texel of index < floor(u(lo)) or > ceil(u(hi)) never enters an
+     * interpolation of a value in [lo, hi]. One texel of margin either way
+     * covers the float rounding of the shader's u. */
+    int i0 = (int)floor(texel_of(table, lo)) - 1, i1 = (int)ceil(texel_of(table, hi)) + 1;
+    i0 = i0 < 0 ? 0 : i0;
+    i1 = i1 > SL_VOLUME_TF_TEXELS - 1 ? SL_VOLUME_TF_TEXELS - 1 : i1;
+    return table->nonzero_before[i1 + 1] - table->nonzero_before[i0] > 0;
+}
+
+sl_status sl_volume_tf_texture_create(GLuint *tex, sl_err *err)
+{
+    glCreateTextures(GL_TEXTURE_1D, 1, tex);
+    glTextureStorage1D(*tex, 1, GL_RGBA32F, SL_VOLUME_TF_TEXELS);
+    glTextureParameteri(*tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(*tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    return sl_gl_check_errors("volume: creating the transfer-function texture", err);
+}
+
+void sl_volume_tf_texture_upload(GLuint tex, const sl_volume_tf_table *table)
+{
+    glTextureSubImage1D(tex, 0, 0, SL_VOLUME_TF_TEXELS, GL_RGBA, GL_FLOAT, table->rgba);
+    sl_volume_counters_now.tf_uploads++;
+}
