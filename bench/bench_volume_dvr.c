@@ -33,6 +33,7 @@
 
 #include "core/sl_clock.h"
 #include "core/sl_technique.h"
+#include "data/sl_dataset_open.h"
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
 #include "gpu/sl_gpu.h"
@@ -119,10 +120,10 @@ static sl_status open_dataset(const bench_dataset *b, int size, sl_dataset **out
         snprintf(path, sizeof path, "%s/data/samples/cranium.nhdr", src ? src : SIGHTLINE_SOURCE_DIR);
         if (access(path, R_OK) != 0)
             return sl_err_set(err, SL_ERR_IO, "%s is missing (scripts/fetch-sample-data)", path);
-        return sl_load_file(path, out, err);
+        return sl_dataset_open(path, NULL, out, err);
     }
     snprintf(json, sizeof json, "{\"generator\":\"%s\",\"size\":%d}", b->key[0] == 'm' ? "marschner_lobb" : "head", size);
-    return sl_generate_json(json, out, err);
+    return sl_dataset_open(json, NULL, out, err);
 }
 
 static sl_status base_params(const sl_technique *t, const bench_dataset *b, sl_params *p, sl_err *err)

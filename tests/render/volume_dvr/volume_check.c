@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "data/sl_dataset_open.h"
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
 #include "image/sl_image.h"
@@ -84,9 +85,7 @@ static sl_dataset *open_dataset(const char *src, sl_err *err)
     sl_dataset *ds = NULL;
     if (strncmp(src, "synthetic:", 10) == 0)
         return synthetic(src + 10, err);
-    if (src[0] == '{')
-        return sl_generate_json(src, &ds, err) == SL_OK ? ds : NULL;
-    return sl_load_file(src, &ds, err) == SL_OK ? ds : NULL;
+    return sl_dataset_open(src, NULL, &ds, err) == SL_OK ? ds : NULL;
 }
 
 static int make_view(const sl_dataset *ds, const double orbit[3], int size, sl_view *view, sl_err *err)
