@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "data/sl_dataset_open.h"
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
 #include "sl_params_json.h"
@@ -334,39 +335,17 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
 sl_status sl_scene_open_dataset(const sl_scene *s, const char *data_dir, sl_dataset **out, sl_err *err)
 {
     *out = NULL;
+    const char *dirs[1] = {data_dir};
+    sl_dataset_dirs where = {.dirs = dirs, .count = data_dir && data_dir[0] ? 1 : 0, .confine = 0};
     if (cJSON_IsObject(s->dataset)) {
-        if (sl_hermite_json_detect(s->dataset))
-            return sl_hermite_dataset_from_json(s->dataset, "inline", out, err);
         char *text = cJSON_PrintUnformatted(s->dataset);
         if (!text)
             return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
-        sl_status st = sl_generate_json(text, out, err);
+        sl_status st = sl_dataset_open(text, &where, out, err);
         free(text);
         return st;
     }
-    const char *name = s->dataset->valuestring;
-    const char *builtin = sl_builtin_lookup(name);
-    if (builtin)
-        return sl_generate_json(builtin, out, err);
-    char path[4096];
-    if (name[0] != '/' && data_dir && data_dir[0])
-        snprintf(path, sizeof path, "%s/%s", data_dir, name);
-    else
-        snprintf(path, sizeof path, "%s", name);
-    if (!strchr(name, '/') && !strchr(name, '.') && access(path, F_OK) != 0) {
-        /* No path, no extension, no such file: most likely a mistyped name. */
-        int n;
-        const sl_builtin_dataset *list = sl_builtin_datasets(&n);
-        char names[512] = "";
-        for (int i = 0; i < n; i++) {
-            strncat(names, list[i].name, sizeof names - strlen(names) - 1);
-            if (i + 1 < n)
-                strncat(names, ", ", sizeof names - strlen(names) - 1);
-        }
-        return sl_err_set(err, SL_ERR_INVALID, "dataset '%.128s' is neither a built-in dataset (%s) nor a file", name,
-                          names);
-    }
-    return sl_load_file(path, out, err);
+    return sl_dataset_open(s->dataset->valuestring, &where, out, err);
 }
 
 sl_status sl_scene_view(const sl_scene *s, const sl_dataset *ds, int frame, sl_view *view, sl_err *err)

@@ -458,6 +458,36 @@ char *sl_msg_pong_text(long long seq)
     return print_and_free(o);
 }
 
+const char *sl_progress_stage_name(sl_progress_stage stage)
+{
+    static const char *const names[] = {"loading", "preparing", "first_frame", "done"};
+    return (unsigned)stage < sizeof names / sizeof names[0] ? names[stage] : "unknown";
+}
+
+char *sl_msg_progress_text(const sl_msg_progress *p)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "progress");
+    cJSON_AddStringToObject(o, "stage", sl_progress_stage_name(p->stage));
+    cJSON_AddNumberToObject(o, "round", p->round);
+    cJSON_AddNumberToObject(o, "version", p->version);
+    cJSON_AddStringToObject(o, "dataset", p->dataset ? p->dataset : "");
+    cJSON_AddStringToObject(o, "technique", p->technique ? p->technique : "");
+    if (p->fraction >= 0 && p->fraction <= 1)
+        cJSON_AddNumberToObject(o, "fraction", p->fraction);
+    else
+        cJSON_AddNullToObject(o, "fraction");
+    cJSON_AddNumberToObject(o, "elapsed_ms", round(p->elapsed_ms * 10) / 10);
+    cJSON_AddNumberToObject(o, "load_ms", round(p->load_ms * 10) / 10);
+    cJSON_AddNumberToObject(o, "prepare_ms", round(p->prepare_ms * 10) / 10);
+    if (p->stage == SL_PROGRESS_DONE) {
+        cJSON_AddBoolToObject(o, "ok", p->ok);
+        cJSON_AddNumberToObject(o, "render_ms", round(p->render_ms * 10) / 10);
+        cJSON_AddNumberToObject(o, "frame", p->frame);
+    }
+    return print_and_free(o);
+}
+
 char *sl_msg_error_text(const char *code, const char *message, const char *field)
 {
     cJSON *o = cJSON_CreateObject();

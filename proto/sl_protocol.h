@@ -185,6 +185,32 @@ char *sl_msg_view_saved_text(const char *name);
 char *sl_msg_control_request_text(int client);
 char *sl_msg_pong_text(long long seq);
 
+/* Long work on a session's scene, in the order it happens (PROTOCOL.md,
+ * "Progress"): loading the dataset, preparing the technique, rendering the
+ * first frame, done. One round of work sends each stage at most once. */
+typedef enum sl_progress_stage {
+    SL_PROGRESS_LOADING = 0,
+    SL_PROGRESS_PREPARING,
+    SL_PROGRESS_FIRST_FRAME,
+    SL_PROGRESS_DONE,
+} sl_progress_stage;
+
+typedef struct sl_msg_progress {
+    sl_progress_stage stage;
+    uint32_t round;                /* per session, increasing: one dataset switch, prepare... */
+    uint32_t version;              /* the state version the work is for */
+    const char *dataset, *technique;
+    double fraction;               /* 0..1 when known, < 0: unknown (sent as null) */
+    double elapsed_ms;             /* since the round began */
+    double load_ms, prepare_ms;    /* so far (0 = none), all stages */
+    double render_ms;              /* done: the first frame's render + readback */
+    uint32_t frame;                /* done: id of that frame, 0 when none */
+    int ok;                        /* done: 1 a frame was published; 0 failed or superseded */
+} sl_msg_progress;
+
+char *sl_msg_progress_text(const sl_msg_progress *p);
+const char *sl_progress_stage_name(sl_progress_stage stage);
+
 /* Binary frames (server -> client): a fixed 40-byte little-endian header
  * followed by `payload_bytes` bytes of JPEG (kind 0) or PNG (kind 1). */
 #define SL_FRAME_HEADER_SIZE 40

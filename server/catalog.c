@@ -24,6 +24,7 @@
 #include <sys/stat.h>
 
 #include "data/sl_generate.h"
+#include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
 
 static const char *schema_sql =
@@ -298,7 +299,8 @@ sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *
     if ((st = checksum_file(real, &size, sum, err)) != SL_OK)
         return st;
     sl_dataset *ds = NULL;
-    if ((st = sl_load_file(real, &ds, err)) != SL_OK)
+    sl_dataset_dirs dirs = {.dirs = data_dirs, .count = dir_count, .confine = 1};
+    if ((st = sl_dataset_open(real, &dirs, &ds, err)) != SL_OK)
         return st;
     st = insert_dataset(db, base, sl_dataset_kind_name(ds->kind), ds, real, NULL, "", size, sum, err);
     sl_dataset_destroy(ds);

@@ -89,6 +89,7 @@ char *sl_http_metrics(sl_server *srv)
     pthread_mutex_lock(&srv->lock);
     sl_metrics m = srv->metrics;
     int sessions = srv->session_count, clients = srv->client_count, pending = srv->pending_count;
+    int prepared = srv->prepared_scenes;
     pthread_mutex_unlock(&srv->lock);
     struct { const char *name, *help; uint64_t v; } counters[] = {
         {"sightline_frames_rendered_total", "Frames rendered and encoded.", m.frames_rendered},
@@ -120,7 +121,15 @@ char *sl_http_metrics(sl_server *srv)
            "# TYPE sightline_pending_connections gauge\nsightline_pending_connections %d\n", pending);
     append(&b, &len, &cap, "# HELP sightline_sessions Live sessions.\n# TYPE sightline_sessions gauge\n"
            "sightline_sessions %d\n", sessions);
-    histogram(&b, &len, &cap, "sightline_render_ms", "Render plus readback wall time per frame, ms.", &m.render_ms);
+    append(&b, &len, &cap, "# HELP sightline_prepared_scenes Prepared technique states held (shared by the sessions "
+           "showing the same scene).\n# TYPE sightline_prepared_scenes gauge\nsightline_prepared_scenes %d\n",
+           prepared);
+    histogram(&b, &len, &cap, "sightline_render_ms", "Render plus readback wall time per frame (no prepare), ms.",
+              &m.render_ms);
+    histogram(&b, &len, &cap, "sightline_dataset_load_ms", "Dataset load or generation time on a loader thread, ms.",
+              &m.load_ms);
+    histogram(&b, &len, &cap, "sightline_prepare_ms", "Technique prepare time on the render thread, ms.",
+              &m.prepare_ms);
     histogram(&b, &len, &cap, "sightline_encode_ms", "JPEG encode wall time per frame, ms.", &m.encode_ms);
     return b;
 }

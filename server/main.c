@@ -3,9 +3,10 @@
  *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH] [--data-dir DIR]...
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
  *                    [--max-pending N] [--max-pending-per-address N]
- *                    [--max-sessions N] [--grace S] [--egl-device D]
+ *                    [--max-sessions N] [--grace S] [--idle-release S] [--egl-device D]
  *                    [--default-dataset NAME] [--hello-timeout S]
- *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]   (tests only)
+ *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]
+ *                    [--test-load-delay-ms MS]   (the --test-* options are for tests only)
  *   sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
  *                    | remove NAME | scan DIR | add-builtins
  * (options may also follow the subcommand).
@@ -49,10 +50,12 @@ static void usage(FILE *f)
             "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
             "                        [--allow-origin URL]... [--max-clients N] [--max-pending N]\n"
             "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
-            "                        [--egl-device software|INDEX] [--default-dataset NAME] [--hello-timeout S]\n"
-            "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]\n"
+            "                        [--idle-release SECONDS] [--egl-device software|INDEX] [--default-dataset NAME]\n"
+            "                        [--hello-timeout S]\n"
+            "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-load-delay-ms MS]\n"
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
-            "                        frame's render, so a scene is slow in a known way)\n"
+            "                        frame's render, and MS before every dataset load, so a scene is slow in a\n"
+            "                        known way)\n"
             "       sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list\n"
             "                        | remove NAME | scan DIR | add-builtins\n"
             "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n");
@@ -163,7 +166,7 @@ int main(int argc, char **argv)
 {
     sl_server_config cfg = {.port = 8080, .bind = "127.0.0.1", .max_clients = 64, .max_pending = 16,
                             .max_pending_per_address = 4, .max_sessions = 32, .grace_s = 300,
-                            .hello_timeout_s = 10};
+                            .idle_release_s = 30, .hello_timeout_s = 10};
     char db_default[PATH_MAX], web_default[PATH_MAX], data_default[PATH_MAX];
     const char *xdg = getenv("XDG_DATA_HOME"), *home = getenv("HOME");
     if (xdg && xdg[0])
@@ -211,6 +214,8 @@ int main(int argc, char **argv)
             ok = parse_int(v, 1, 10000, &cfg.max_sessions), i++;
         } else if (strcmp(a, "--grace") == 0 && v) {
             ok = parse_int(v, 0, 86400, &cfg.grace_s), i++;
+        } else if (strcmp(a, "--idle-release") == 0 && v) {
+            ok = parse_int(v, 0, 86400, &cfg.idle_release_s), i++;
         } else if (strcmp(a, "--hello-timeout") == 0 && v) {
             ok = parse_int(v, 1, 3600, &cfg.hello_timeout_s), i++;
         } else if (strcmp(a, "--test-frame-delay-ms") == 0 && v) {
@@ -221,6 +226,10 @@ int main(int argc, char **argv)
             int ms = 0;
             ok = parse_int(v, 0, 10000, &ms), i++;
             cfg.test_frame_fixed_ms = ms;
+        } else if (strcmp(a, "--test-load-delay-ms") == 0 && v) {
+            int ms = 0;
+            ok = parse_int(v, 0, 60000, &ms), i++;
+            cfg.test_load_delay_ms = ms;
         } else if (strcmp(a, "--default-dataset") == 0 && v) {
             cfg.default_dataset = v, i++;
         } else if (strcmp(a, "--egl-device") == 0 && v) {

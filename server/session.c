@@ -9,7 +9,11 @@
  * requester (wants_control), told to the controller once by write_next, so
  * repeats merge and only a client's own replies fill its reply ring. A
  * session with no clients lives on for the grace period, then is doomed;
- * the render thread frees it with its GL state.
+ * the render thread frees it with its GL state (and, --idle-release seconds
+ * after its last client left, already lets go of its prepared scene:
+ * idle_since_ms). Progress texts (render thread) reach each client once, in
+ * order, from the session's ring; a client joining mid-round gets the
+ * round from its start.
  * Flow control: state changes reach each client as one coalesced `state`
  * patch (newest wins), frames as the session's latest frame, and only while
  * the client has fewer than SL_PROTO_ACK_WINDOW unacknowledged frames.
@@ -176,6 +180,8 @@ void sl_session_free(sl_session *s)
     free(s->info_bounds);
     free(s->info_counts);
     free(s->info_attrs);
+    for (int i = 0; i < SL_PROGRESS_RING; i++)
+        free(s->progress_text[i]);
     cJSON_Delete(s->bounds);
     free(s);
 }
@@ -258,6 +264,7 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
     st->stream = SL_STREAM_DEFAULTS;
     s->empty_since_ms = sl_clock_ms();
+    s->idle_since_ms = s->empty_since_ms;
     pthread_mutex_lock(&srv->lock);
     s->next = srv->sessions;
     srv->sessions = s;
@@ -279,9 +286,12 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     c->hello_done = 1;
     sl_ws_pending_leave(srv, c);
     /* Render errors from before the join are history, not news for this client. */
+    /* So is a finished round of progress; one in flight is sent from its start. */
     pthread_mutex_lock(&srv->lock);
     srv->client_count++;
     c->error_seq = s->error_seq;
+    s->idle_since_ms = 0;
+    c->progress_seq = s->progress_closed ? s->progress_seq : s->progress_round_start;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
     sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
@@ -721,6 +731,10 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
         if (s->client_count == 0)
             s->empty_since_ms = sl_clock_ms();
         pthread_mutex_lock(&srv->lock);
+        if (s->client_count == 0) {
+            s->idle_since_ms = s->empty_since_ms; /* the render thread lets go of its prepared state later */
+            pthread_cond_signal(&srv->wake);
+        }
         for (int i = 0; i < s->snap_req_count; i++)
             if (s->snap_req[i] == c->id)
                 s->snap_req[i] = 0;
@@ -807,7 +821,7 @@ void sl_sessions_on_wake(sl_server *srv)
         /* The session's newest render error is sent by write_next (coalesced:
          * a client that is behind gets the latest error once, not a backlog). */
         for (sl_client *c = s->clients; c; c = c->next)
-            if (c->error_seq != s->error_seq)
+            if (c->error_seq != s->error_seq || c->progress_seq != s->progress_seq)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
@@ -912,6 +926,21 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
             return write_text_now(c, sl_msg_control_request_text(r->id));
         }
     }
+    /* The session's progress texts, each once and in order (a client more
+     * than the ring behind skips the oldest); before errors, so a failed
+     * load's `done` precedes its load_failed. */
+    char *progress = NULL;
+    pthread_mutex_lock(&srv->lock);
+    if (c->progress_seq != s->progress_seq) {
+        uint32_t next = c->progress_seq + 1, oldest = s->progress_seq - (SL_PROGRESS_RING - 1);
+        if (s->progress_seq >= SL_PROGRESS_RING && next < oldest)
+            next = oldest;
+        c->progress_seq = next;
+        progress = strdup(s->progress_text[next % SL_PROGRESS_RING]);
+    }
+    pthread_mutex_unlock(&srv->lock);
+    if (progress)
+        return write_text_now(c, progress);
     char *error = NULL;
     pthread_mutex_lock(&srv->lock);
     if (c->error_seq != s->error_seq) {

@@ -4,9 +4,12 @@
  *   ws.c       lws context, WebSocket protocol, static files (service thread)
  *   session.c  sessions, clients, control, grace period, message handling
  *              (service thread)
- *   render.c   the render thread: owns sl_gpu and one sl_pipeline per session
+ *   render.c   the render thread: owns sl_gpu, the encoder, the prepared scenes
+ *   prepared_cache.c  sl_pipelines shared by sessions on one scene (render thread)
+ *   progress.c the `progress` rounds of long work, posted to sessions (render thread)
  *   interactive_scale.c  the adaptive scale of interactive frames (render thread)
- *   dataset_cache.c  loaded datasets shared by sessions (render thread)
+ *   dataset_cache.c  datasets by source: cached, shared, loaded on its own
+ *              loader threads (any caller; its own lock)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
@@ -14,12 +17,17 @@
  * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
- * render thread owns every GL object. They share only the fields marked
- * "[lock]" below, guarded by sl_server.lock; the render thread waits on
- * sl_server.wake and wakes the service thread with lws_cancel_service.
+ * render thread owns every GL object; the dataset cache's loader threads
+ * only read files and run generators, behind the cache's own lock. The
+ * service and render threads share only the fields marked "[lock]" below,
+ * guarded by sl_server.lock; the render thread waits on sl_server.wake
+ * (a finished load broadcasts it too) and wakes the service thread with
+ * lws_cancel_service. Lock order: sl_server.lock, then the cache's lock.
  * Fields marked "[service]" or "[render]" belong to that thread alone.
  * Nothing is queued without a bound: state is "newest wins", a session keeps
- * one latest frame, a client keeps at most SL_CLIENT_MAX_TEXT replies.
+ * one latest frame and its newest SL_PROGRESS_RING progress texts, a client
+ * keeps at most SL_CLIENT_MAX_TEXT replies, and a session waits for at most
+ * one dataset load (so the loaders' queue is bounded by the sessions).
  * Only a client's own requests go into its reply ring (so only it can fill
  * it and get closed for it); whatever other clients or the render thread
  * cause reaches it as coalesced state on the client or session — the state
@@ -46,6 +54,9 @@ struct lws;
 struct lws_context;
 typedef struct sl_pipeline sl_pipeline;
 typedef struct sl_dataset sl_dataset;
+typedef struct sl_technique sl_technique;
+typedef struct sl_gpu sl_gpu;
+typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 
 #define SL_SERVER_MAX_ORIGINS 8
 #define SL_SERVER_MAX_DATA_DIRS 8
@@ -53,6 +64,7 @@ typedef struct sl_dataset sl_dataset;
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
+#define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
     int port;                      /* 0: any free port (printed on stdout) */
@@ -68,11 +80,14 @@ typedef struct sl_server_config {
     int max_pending_per_address;   /* default 4: of those, from one peer address */
     int max_sessions;              /* default 32 */
     int grace_s;                   /* default 300 */
+    int idle_release_s;            /* default 30: a session without clients this long lets go of its
+                                      prepared state (re-prepared when it renders again) */
     int hello_timeout_s;           /* default 10: seconds from upgrade to hello */
     const char *egl_device;        /* NULL: auto */
     const char *default_dataset;   /* NULL: the first catalog dataset the first technique accepts */
     double test_frame_delay_ms;    /* tests only: sleep this x (frame pixels / session pixels) per frame */
     double test_frame_fixed_ms;    /* tests only: and this, whatever the size (a vertex-bound render) */
+    double test_load_delay_ms;     /* tests only: every dataset load sleeps this long first (loader thread) */
 } sl_server_config;
 
 /* ---- frames (encoder.c) ---- */
@@ -143,6 +158,46 @@ double sl_iscale_choose(sl_iscale *a, const sl_stream_settings *st, int *step);
  * interactive frame at ladder step `step`, or a full-size still. */
 void sl_iscale_record(sl_iscale *a, int interactive, int step, double cost_ms);
 
+/* prepared_cache.c (render thread only): one sl_pipeline per (dataset
+ * source, technique, parameters equal up to the frame level), shared by the
+ * sessions that show it; the last release destroys it. */
+typedef struct sl_prepared {
+    int refs;                        /* sessions holding it */
+    char source[SL_SOURCE_MAX];
+    const sl_technique *technique;
+    sl_params key;                   /* the parameters it was made for */
+    sl_dataset *dataset;             /* borrowed: the pipeline owns it */
+    sl_pipeline *pipeline;           /* owned */
+    struct sl_prepared *next;
+} sl_prepared;
+typedef struct sl_prepared_cache {
+    sl_gpu *gpu;                     /* borrowed */
+    sl_prepared *list;
+    int count;
+} sl_prepared_cache;
+/* A prepared scene of (source, t, params) holding dataset ds, with a new
+ * reference; NULL when there is none. */
+sl_prepared *sl_prepared_find(sl_prepared_cache *c, const char *source, const sl_technique *t,
+                              const sl_params *params, const sl_dataset *ds);
+/* A new reference to the dataset some prepared scene of source holds, or NULL. */
+sl_dataset *sl_prepared_dataset_of(sl_prepared_cache *c, const char *source);
+/* A new prepared scene (refs 1) of ds (consumed, also on failure); nothing
+ * is prepared until its first render. SL_ERR_NOMEM, SL_ERR_LIMIT (source
+ * too long), SL_ERR_INVALID (t cannot draw ds). */
+sl_status sl_prepared_create(sl_prepared_cache *c, const char *source, sl_dataset *ds, const sl_technique *t,
+                             const sl_params *params, sl_prepared **out, sl_err *err);
+void sl_prepared_release(sl_prepared_cache *c, sl_prepared *p); /* NULL is fine */
+
+/* progress.c (render thread): the session's current round of long work. */
+typedef struct sl_progress_round {
+    int active;
+    uint32_t id;                     /* = the session's progress_round while active */
+    uint32_t version;                /* state version worked on */
+    char dataset[SL_PROTO_NAME_MAX], technique[SL_PROTO_NAME_MAX];
+    double t0_ms, load_ms, prepare_ms;
+    int stage;                       /* the last stage posted, -1 none */
+} sl_progress_round;
+
 typedef struct sl_client sl_client;
 typedef struct sl_session sl_session;
 
@@ -167,6 +222,7 @@ struct sl_client {                  /* [service] */
     sl_frame_buf *snapshot;         /* PNG waiting to be sent */
     uint32_t error_seq;             /* session error_seq already reported (set at attach) */
     int wants_control;              /* asked for control; the controller has not been told yet */
+    uint32_t progress_seq;          /* newest session progress text sent (set at attach) */
     int close_after_send;
     sl_client *next;                /* in session->clients */
 };
@@ -198,6 +254,13 @@ struct sl_session {
     char *info_bounds, *info_counts, *info_attrs; /* [lock] set by the render thread after a load */
     char info_dataset[SL_PROTO_NAME_MAX];    /* [lock] which dataset the info describes */
     int info_pending;                        /* [lock] not yet taken by the service thread */
+    double idle_since_ms;                    /* [lock] written by the service thread: 0 while
+                                                clients are attached, else when the last left */
+    uint32_t progress_round;                 /* [lock] current round of long work (progress.c) */
+    uint32_t progress_seq;                   /* [lock] number of the newest progress text (0: none) */
+    uint32_t progress_round_start;           /* [lock] progress_seq before the current round's first */
+    int progress_closed;                     /* [lock] the current round's `done` was posted */
+    char *progress_text[SL_PROGRESS_RING];   /* [lock] owned texts, text n at n % SL_PROGRESS_RING */
     sl_session *next;                        /* [lock] in server->sessions */
     /* [service] */
     sl_client *clients;
@@ -207,8 +270,10 @@ struct sl_session {
     uint32_t dispatched_frame;               /* newest frame id dispatched to clients */
     cJSON *bounds;                           /* [[x,y,z],[x,y,z]] of the loaded dataset, or NULL */
     /* [render] */
-    sl_pipeline *pipeline;
-    char loaded_source[SL_SOURCE_MAX];
+    sl_prepared *prepared;                   /* the scene it renders through (a reference), or NULL */
+    sl_dataset_load *load;                   /* the dataset load it waits for, or NULL */
+    int load_is_new;                         /* that load was queued for it (a load, not a cache hit) */
+    sl_progress_round round;
     sl_session_state good;                   /* the last state that rendered a frame */
     int has_good;
     sl_iscale iscale;                        /* interactive scale estimates */
@@ -229,6 +294,7 @@ typedef struct sl_metrics {                  /* [lock] */
     uint64_t dataset_loads, dataset_cache_hits, dataset_load_failures;
     uint64_t refused_full, refused_address, pending_evicted;  /* WebSocket admission */
     sl_histogram render_ms, encode_ms;
+    sl_histogram load_ms, prepare_ms;        /* dataset loads (loader thread), technique prepares */
 } sl_metrics;
 
 void sl_histogram_add(sl_histogram *h, double ms);
@@ -249,6 +315,7 @@ typedef struct sl_server {
     sl_client *pending;                      /* [service] those connections, newest first */
     int next_client_id;                      /* [service] */
     sl_metrics metrics;                      /* [lock] */
+    int prepared_scenes;                     /* [lock] live prepared scenes (written by the render thread) */
     int stop;                                /* [lock] */
     int render_ready;                        /* [lock] 1 up, -1 failed */
     char gpu_renderer[128];                  /* [lock] */
@@ -265,30 +332,63 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c);
 void sl_sessions_on_wake(sl_server *srv);     /* dispatch frames, snapshots, errors */
 void sl_sessions_sweep(sl_server *srv);       /* expire sessions past the grace period */
 void sl_sessions_destroy_all(sl_server *srv); /* at shutdown, after the render thread ended */
-void sl_session_free(sl_session *s);          /* render thread or shutdown; not the pipeline */
+void sl_session_free(sl_session *s);          /* render thread or shutdown; after its scene and load were released */
 /* Queues a text message for c (takes ownership of text). Returns -1 when the
  * client's queue is full (the client is then closed). */
 int sl_client_queue_text(sl_client *c, char *text);
 /* Called from ws.c on writable: sends one message. Returns -1 to close. */
 int sl_client_write_next(sl_server *srv, sl_client *c);
 
-/* dataset_cache.c (render thread only) */
+/* dataset_cache.c (any thread; its own lock): datasets by source, loaded on
+ * SL_DATASET_LOADERS loader threads, the last SL_DATASET_CACHE_SLOTS kept. */
 #define SL_DATASET_CACHE_SLOTS 4
-typedef struct sl_dataset_cache {
-    struct {
-        char source[SL_SOURCE_MAX];
-        sl_dataset *dataset;  /* one owner's reference, NULL when empty */
-        uint64_t used;        /* clock of the last get */
-        uint64_t stamp[4];    /* files: inode, size, mtime s/ns when loaded */
-    } slot[SL_DATASET_CACHE_SLOTS];
-    uint64_t clock, loads, hits;
-} sl_dataset_cache;
-/* The dataset of source (a file path when is_file, else generator JSON):
- * the cached copy, or loaded and cached. *out is the caller's own reference
- * (give it to sl_pipeline_set_dataset or sl_dataset_destroy it). On failure
- * *out is NULL and err says why (a changed file's stale entry is dropped). */
-sl_status sl_dataset_cache_get(sl_dataset_cache *c, const char *source, int is_file, sl_dataset **out, sl_err *err);
-void sl_dataset_cache_deinit(sl_dataset_cache *c); /* drops the cache's references */
+#define SL_DATASET_LOADERS 2
+typedef struct sl_dataset_cache sl_dataset_cache;  /* a sl_dataset_load is one load, shared by its waiters */
+typedef struct sl_dataset_cache_desc {
+    int loaders;                 /* loader threads, 0 = SL_DATASET_LOADERS */
+    /* A load finished: its status and time (loader thread, no cache lock held). */
+    void (*on_done)(void *arg, sl_status status, double load_ms);
+    void *arg;
+    double test_delay_ms;        /* tests only: every load sleeps this long first */
+    const char *const *data_dirs; /* borrowed: a file must lie inside one (sl_dataset_open's confinement) */
+    int data_dir_count;
+} sl_dataset_cache_desc;
+typedef enum sl_dataset_origin {
+    SL_DATASET_CACHED,      /* *out is set: no load */
+    SL_DATASET_SHARED_LOAD, /* *load: joined a load of the same source already in flight */
+    SL_DATASET_NEW_LOAD,    /* *load: queued a new load */
+} sl_dataset_origin;
+/* Starts the loader threads. SL_ERR_NOMEM when memory or a thread is missing. */
+sl_status sl_dataset_cache_create(const sl_dataset_cache_desc *desc, sl_dataset_cache **out, sl_err *err);
+/* Stops the loaders (a running load finishes first) and drops the cache's
+ * references. Every load must have been released. NULL is fine. */
+void sl_dataset_cache_destroy(sl_dataset_cache *c);
+/* Never waits for a load. The dataset of source (a file path when is_file,
+ * else generator JSON): cached (*out: the caller's own reference, for
+ * sl_pipeline_set_dataset or sl_dataset_destroy), or *load: a reference to
+ * its load (release it with sl_dataset_load_release). *origin says which.
+ * A cached file whose inode, size or mtime changed is loaded again. Fails
+ * only when out of memory or for a source of SL_SOURCE_MAX bytes or more. */
+sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int is_file, sl_dataset **out,
+                                   sl_dataset_load **load, sl_dataset_origin *origin, sl_err *err);
+/* 0 while the load is queued or running. 1 when it finished; then, when out
+ * is not NULL: *status SL_OK and *out the caller's own reference, or the
+ * loader's failure (*out NULL, err filled); *load_ms its time on the loader. */
+int sl_dataset_load_poll(sl_dataset_cache *c, sl_dataset_load *l, sl_dataset **out, double *load_ms,
+                         sl_status *status, sl_err *err);
+const char *sl_dataset_load_source(const sl_dataset_load *l); /* immutable */
+/* Drops the caller's reference; a queued load nobody waits for is dropped. NULL is fine. */
+void sl_dataset_load_release(sl_dataset_cache *c, sl_dataset_load *l);
+
+/* progress.c (render thread) */
+/* Starts a round for st (ending an unfinished one with done, ok 0). */
+void sl_progress_begin(sl_server *srv, sl_session *s, const sl_session_state *st);
+/* Posts stage (loading, preparing, first_frame) once per round, in order; a
+ * stage at or before the last one posted, or no active round, does nothing. */
+void sl_progress_stage_post(sl_server *srv, sl_session *s, sl_progress_stage stage);
+/* Ends the active round with done: ok 1 and the frame that showed the work
+ * (its id and render ms), or ok 0 when it ended without one. */
+void sl_progress_end(sl_server *srv, sl_session *s, int ok, double render_ms, uint32_t frame);
 
 /* render.c */
 sl_status sl_render_start(sl_server *srv, sl_err *err);

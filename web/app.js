@@ -2,7 +2,9 @@
 // canvas with createImageBitmap (interactive frames, smaller, stretched to the
 // canvas), acks them, wires camera input (camera.js),
 // schema-generated parameter controls (controls.js), dataset/technique
-// pickers, views, snapshots, sharing, control requests and the status line.
+// pickers, views, snapshots, sharing, control requests, the progress bar of
+// long loads and prepares (progress.js) and the status line (fps, latency,
+// size, and the load, prepare, render and encode ms separately).
 // The session id and token live in the URL fragment (#session=..&token=..),
 // so a reload or a shared link joins the same session.
 // window.sightline exposes read-only counters for the browser test.
@@ -10,10 +12,12 @@
 import { Connection } from './protocol.js';
 import { CameraControl } from './camera.js';
 import { ParamControls } from './controls.js';
+import { ProgressOverlay } from './progress.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
 const ctx2d = canvas.getContext('2d');
+const progress = new ProgressOverlay($('progress'));
 
 const frag = new URLSearchParams(location.hash.slice(1));
 const conn = new Connection({
@@ -47,6 +51,8 @@ window.sightline = {
   get cameraLimits() { return { maxElevation: camera.maxElevation, defaults: camera.defaults }; },
   get stateVersion() { return app.stateVersion; },
   get connected() { return conn.ws?.readyState === WebSocket.OPEN; },
+  get progressStage() { return progress.stage; },
+  get timings() { return progress.timings; },
 };
 
 const camera = new CameraControl(canvas, (phase, cam) => {
@@ -161,6 +167,8 @@ function updateStatus() {
   if (app.latencyMs !== null) parts.push(`latency ${app.latencyMs.toFixed(0)} ms`);
   if (f) {
     parts.push(`${f.width}×${f.height} ${(f.bytes / 1024).toFixed(1)} KiB`);
+    const t = progress.timings;
+    if (t) parts.push(`load ${t.loadMs.toFixed(0)} ms`, `prepare ${t.prepareMs.toFixed(0)} ms`);
     parts.push(`render ${f.renderMs.toFixed(1)} ms`, `encode ${f.encodeMs.toFixed(1)} ms`);
     parts.push(f.interactive ? `interactive ${scaleLabel(f.width)}` : 'still');
     parts.push(`frame ${f.frameId}`);
@@ -233,6 +241,7 @@ conn.addEventListener('message', (ev) => {
       camera.adopt(msg.state.camera, msg.state.bounds || null);
       updateShareLink();
       setBanner('');
+      progress.hide();
       conn.send({ type: 'list_views' });
       break;
     case 'state':
@@ -263,7 +272,11 @@ conn.addEventListener('message', (ev) => {
       $('request-list').append(b);
       break;
     }
+    case 'progress':
+      progress.update(msg);
+      break;
     case 'error':
+      if (msg.code === 'load_failed') progress.hide();
       setBanner(`${msg.code}: ${msg.message}${msg.field ? ` (${msg.field})` : ''}`);
       setTimeout(() => { if ($('banner').textContent.startsWith(msg.code)) setBanner(''); }, 4000);
       break;

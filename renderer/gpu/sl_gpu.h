@@ -83,6 +83,12 @@ typedef struct sl_program_desc {
 } sl_program_desc;
 sl_status sl_gl_program_create(const sl_program_desc *desc, GLuint *program, sl_err *err);
 
+/* After deleting buffers that the last draw used: one throw-away draw so the
+ * driver drops its references to them and their memory is freed (unbind.c;
+ * Mesa keeps the last draw's vertex and index buffers bound otherwise).
+ * Costs a shader compile; never fails (a link failure only skips the draw). */
+void sl_gpu_drop_references(void);
+
 /* An offscreen target: RGBA8 colour + 32F depth (reversed-Z, see sl_camera.h),
  * optional MSAA resolved into single-sample textures by sl_target_resolve. */
 typedef struct sl_target {

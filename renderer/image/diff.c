@@ -84,7 +84,7 @@ sl_status sl_diff_images_covered(const sl_image *a, const sl_image *b, double ba
     size_t n = (size_t)a->width * (size_t)a->height;
     double sum = 0.0, sq = 0.0;
     int max_d = 0;
-    long bad = 0, covered = 0;
+    long bad = 0, covered = 0, histogram[256] = {0};
     for (size_t i = 0; i < n; i++) {
         const uint8_t *pa = a->rgba + i * 4, *pb = b->rgba + i * 4;
         if (background && is_background(pa, background) && is_background(pb, background))
@@ -98,6 +98,7 @@ sl_status sl_diff_images_covered(const sl_image *a, const sl_image *b, double ba
                 d = e;
         }
         sum += d;
+        histogram[d]++;
         if (d > max_d)
             max_d = d;
         if (d > bad_threshold)
@@ -110,6 +111,15 @@ sl_status sl_diff_images_covered(const sl_image *a, const sl_image *b, double ba
     out->compared = out->both_hit = covered;
     out->mean_abs = covered ? sum / (double)covered : 0.0;
     out->max_abs = max_d;
+    /* The value at rank floor(0.99 (covered - 1)) of the sorted differences. */
+    long rank = covered ? (long)(0.99 * (double)(covered - 1)) : 0, below = 0;
+    for (int d = 0; d < 256 && covered; d++) {
+        below += histogram[d];
+        if (below > rank) {
+            out->p99_abs = d;
+            break;
+        }
+    }
     double mse = covered ? sq / (3.0 * (double)covered) : 0.0;
     out->psnr_db = mse > 0.0 ? 10.0 * log10(255.0 * 255.0 / mse) : INFINITY;
     out->bad_count = bad;

@@ -20,6 +20,7 @@
 typedef struct sl_diff_result {
     int width, height;
     double mean_abs, max_abs;   /* colour: 0..255 units; depth: world units */
+    double p99_abs;             /* colour only: 99th percentile (rank floor(0.99 (n - 1))) of the compared pixels */
     double psnr_db;             /* colour only (depth: over pixels both hit, peak = max depth) */
     double bad_pct;             /* 100 * bad_count / compared (0 when compared == 0) */
     long bad_count;             /* difference > threshold; depth: + coverage mismatches */

@@ -79,35 +79,52 @@ sl_status sl_pipeline_set_technique(sl_pipeline *p, const sl_technique *t, const
     return SL_OK;
 }
 
-sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
-                             sl_frame_stats *stats, sl_err *err)
+int sl_pipeline_needs_prepare(const sl_pipeline *p)
 {
-    memset(stats, 0, sizeof *stats);
+    return p->stale || !p->state || sl_params_compare(&p->params, &p->prepared_params) >= SL_INVALIDATE_PREPARED;
+}
+
+static sl_status check_selection(const sl_pipeline *p, sl_err *err)
+{
     if (!p->dataset || !p->technique)
         return sl_err_set(err, SL_ERR_INVALID, "no dataset or technique selected");
     if (!(p->technique->dataset_kinds & (unsigned)p->dataset->kind))
         return sl_err_set(err, SL_ERR_INVALID, "technique '%s' cannot render a %s dataset",
                           p->technique->name, sl_dataset_kind_name(p->dataset->kind));
-    if (!p->stale && sl_params_compare(&p->params, &p->prepared_params) >= SL_INVALIDATE_PREPARED)
-        release_state(p);
-    if (p->stale || !p->state) {
-        release_state(p);
-        double t0 = sl_clock_ms();
-        sl_status st = p->technique->prepare(p->gpu, p->dataset, &p->params, &p->state, err);
-        if (st != SL_OK) {
-            p->state = NULL;
-            return st;
-        }
-        glFinish();
-        stats->prepare_ms = sl_clock_ms() - t0;
-        stats->prepared = 1;
-        if (p->technique->prepare_stats) {
-            p->technique->prepare_stats(p->state, &stats->prepare);
-            stats->prepare_reported = 1;
-        }
-        p->prepared_params = p->params;
-        p->stale = 0;
+    return SL_OK;
+}
+
+sl_status sl_pipeline_prepare(sl_pipeline *p, sl_frame_stats *stats, sl_err *err)
+{
+    sl_status st = check_selection(p, err);
+    if (st != SL_OK || !sl_pipeline_needs_prepare(p))
+        return st;
+    release_state(p);
+    double t0 = sl_clock_ms();
+    st = p->technique->prepare(p->gpu, p->dataset, &p->params, &p->state, err);
+    if (st != SL_OK) {
+        p->state = NULL;
+        return st;
     }
+    glFinish();
+    stats->prepare_ms = sl_clock_ms() - t0;
+    stats->prepared = 1;
+    if (p->technique->prepare_stats) {
+        p->technique->prepare_stats(p->state, &stats->prepare);
+        stats->prepare_reported = 1;
+    }
+    p->prepared_params = p->params;
+    p->stale = 0;
+    return SL_OK;
+}
+
+sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
+                             sl_frame_stats *stats, sl_err *err)
+{
+    memset(stats, 0, sizeof *stats);
+    sl_status prep = sl_pipeline_prepare(p, stats, err);
+    if (prep != SL_OK)
+        return prep;
     int want_samples = samples > 1 ? samples : 1;
     if (p->target.width != view->width || p->target.height != view->height || p->target.samples != want_samples) {
         sl_target_deinit(&p->target);

@@ -42,6 +42,16 @@ const sl_dataset *sl_pipeline_dataset(const sl_pipeline *p);
  * happens at the next render, and only as much as the change requires. */
 sl_status sl_pipeline_set_technique(sl_pipeline *p, const sl_technique *t, const sl_params *params, sl_err *err);
 
+/* Whether the next render would run the technique's prepare (a new dataset
+ * or technique, a parameter that invalidates prepared state, or none yet). */
+int sl_pipeline_needs_prepare(const sl_pipeline *p);
+
+/* Runs the technique's prepare now when sl_pipeline_needs_prepare says so
+ * (else does nothing and returns SL_OK), filling stats' prepare fields, so a
+ * caller can tell apart the prepare and the first render (the server reports
+ * both). Errors as sl_pipeline_render's prepare: the state stays unprepared. */
+sl_status sl_pipeline_prepare(sl_pipeline *p, sl_frame_stats *stats, sl_err *err);
+
 /* Renders one frame of view (width/height taken from view) with the given
  * MSAA samples (0 or 1 = none) and leaves it in the pipeline's target. */
 sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,

@@ -293,20 +293,6 @@ static void check_own_cameras(const harness *h, worker *w)
         sl_image_deinit(&ref[k]);
 }
 
-static long rss_kib(pid_t pid)
-{
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE *f = fopen(path, "r");
-    long kib = -1;
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, "VmRSS:", 6) == 0)
-            kib = atol(line + 6);
-    if (f)
-        fclose(f);
-    return kib;
-}
-
 static double healthz_ms(int port)
 {
     double t0 = sl_clock_ms();
@@ -317,11 +303,7 @@ static double healthz_ms(int port)
 
 int main(void)
 {
-    /* A small ASan quarantine, so resident memory reflects live data, not freed buffers. */
-    const char *asan = getenv("ASAN_OPTIONS");
-    char opts[512];
-    snprintf(opts, sizeof opts, "%s%squarantine_size_mb=8", asan ? asan : "", asan && asan[0] ? ":" : "");
-    setenv("ASAN_OPTIONS", opts, 1);
+    harness_small_asan_quarantine();
     harness h;
     /* 16 clients connect at once, all from 127.0.0.1: above the default pending
      * cap of one address (--max-pending-per-address 4), which would refuse most. */
@@ -343,7 +325,7 @@ int main(void)
     pthread_barrier_wait(&barrier);          /* all connected: round 1 starts */
     double worst = 0;
     pthread_barrier_wait(&barrier);          /* round 1 sent and drained */
-    long rss1 = rss_kib(h.pid);
+    long rss1 = harness_rss_kib(h.pid);
     double hz = healthz_ms(h.port);
     worst = fmax(worst, hz);
     pthread_barrier_wait(&barrier);          /* round 2 starts */
@@ -354,7 +336,7 @@ int main(void)
     for (int i = 0; i < CLIENTS; i++)
         pthread_join(th[i], NULL);
     double total_ms = sl_clock_ms() - t0;
-    long rss2 = rss_kib(h.pid);
+    long rss2 = harness_rss_kib(h.pid);
 
     int connected = 0, final_ok = 0, frames = 0;
     for (int i = 0; i < CLIENTS; i++) {

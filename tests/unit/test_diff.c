@@ -543,6 +543,29 @@ static void test_tool(void)
     sl_depth_image_deinit(&db);
 }
 
+/* p99_abs: the difference at rank floor(0.99 (n - 1)) of the covered pixels
+ * sorted; 200 covered pixels with differences 0..199 (over a 0 background,
+ * 56 background pixels not counted) give rank 197, difference 197. */
+static void test_colour_p99(void)
+{
+    sl_image a = {.width = 16, .height = 16, .rgba = calloc(16 * 16, 4)}, b = {.width = 16, .height = 16, .rgba = calloc(16 * 16, 4)};
+    SL_CHECK(a.rgba && b.rgba);
+    if (!a.rgba || !b.rgba)
+        return;
+    for (int i = 0; i < 200; i++) {
+        a.rgba[4 * i] = 255;                   /* covered in a */
+        b.rgba[4 * i] = (uint8_t)(255 - i);    /* red differs by i */
+    }
+    uint8_t bg[3] = {0, 0, 0};
+    sl_diff_result r;
+    sl_err err;
+    SL_CHECK(sl_diff_images_covered(&a, &b, 8.0, bg, &r, NULL, &err) == SL_OK);
+    SL_CHECK_MSG(r.compared == 200 && r.p99_abs == 197 && r.max_abs == 199, "compared %ld p99 %g max %g", r.compared,
+                 r.p99_abs, r.max_abs);
+    free(a.rgba);
+    free(b.rgba);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/sl_test_diff_XXXXXX");
@@ -560,5 +583,6 @@ int main(void)
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0)
         fprintf(stderr, "warning: could not remove %s\n", tmpdir);
+    test_colour_p99();
     SL_TEST_END();
 }

@@ -162,7 +162,9 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
     SL_CHECK(sl_view_init(&moved, sl_dataset_radius(pds), &err) == SL_OK);
     SL_CHECK(make_view(pds, 30.0, W / 2, H / 2, &small, &err) == SL_OK);
 
+    SL_CHECK_MSG(sl_pipeline_needs_prepare(pipe), "%s: nothing prepared yet, but no prepare due", t->name);
     SL_CHECK_MSG(render(pipe, &view, 1, "first frame", t->name) == 1, "%s: the first frame must prepare", t->name);
+    SL_CHECK_MSG(!sl_pipeline_needs_prepare(pipe), "%s: a prepare is due after the first frame", t->name);
     SL_CHECK_MSG(render(pipe, &view, 1, "same view", t->name) == 0, "%s: the same view re-prepared", t->name);
     SL_CHECK_MSG(render(pipe, &moved, 1, "camera move", t->name) == 0, "%s: a camera move re-prepared", t->name);
     SL_CHECK_MSG(render(pipe, &small, 1, "smaller view", t->name) == 0, "%s: a view size change re-prepared",
@@ -181,6 +183,8 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
         }
         SL_CHECK(sl_pipeline_set_technique(pipe, t, &params, &err) == SL_OK);
         int want = d->invalidates >= SL_INVALIDATE_PREPARED;
+        SL_CHECK_MSG(sl_pipeline_needs_prepare(pipe) == want, "%s: changing '%s': needs_prepare %d", t->name, d->name,
+                     sl_pipeline_needs_prepare(pipe));
         int got = render(pipe, &view, 1, d->name, t->name);
         SL_CHECK_MSG(got == want, "%s: changing '%s' (%s) %s prepare", t->name, d->name,
                      want ? "invalidates PREPARED" : "invalidates FRAME only", got ? "re-ran" : "did not re-run");
@@ -195,7 +199,13 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
     sl_dataset *ds2 = make_dataset(t->dataset_kinds, &err);
     if (ds2) {
         sl_pipeline_set_dataset(pipe, ds2);
-        SL_CHECK_MSG(render(pipe, &view, 1, "new dataset", t->name) == 1, "%s: a new dataset did not re-prepare",
+        /* An explicit prepare (the server announces it first); the render after it does not prepare again. */
+        sl_frame_stats ps;
+        memset(&ps, 0, sizeof ps);
+        SL_CHECK(sl_pipeline_needs_prepare(pipe));
+        SL_CHECK_MSG(sl_pipeline_prepare(pipe, &ps, &err) == SL_OK && ps.prepared == 1 && ps.prepare_ms >= 0,
+                     "%s: prepare of a new dataset: %s", t->name, err.message);
+        SL_CHECK_MSG(render(pipe, &view, 1, "new dataset", t->name) == 0, "%s: the render after a prepare prepared",
                      t->name);
     }
     sl_pipeline_destroy(pipe);

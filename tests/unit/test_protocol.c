@@ -107,6 +107,38 @@ int main(void)
     cJSON_Delete(ej);
     free(e);
 
+    /* progress: null fraction when unknown, a number when known; done carries ok, frame and render ms */
+    sl_msg_progress pm = {.stage = SL_PROGRESS_LOADING, .round = 3, .version = 7, .dataset = "furball_787k",
+                          .technique = "tubes", .fraction = -1, .elapsed_ms = 12.34};
+    char *pt = sl_msg_progress_text(&pm);
+    cJSON *pj = cJSON_Parse(pt);
+    SL_CHECK(pj && strcmp(cJSON_GetObjectItem(pj, "type")->valuestring, "progress") == 0);
+    SL_CHECK(pj && strcmp(cJSON_GetObjectItem(pj, "stage")->valuestring, "loading") == 0);
+    SL_CHECK(pj && cJSON_IsNull(cJSON_GetObjectItem(pj, "fraction")));
+    SL_CHECK(pj && cJSON_GetObjectItem(pj, "round")->valuedouble == 3 && cJSON_GetObjectItem(pj, "version")->valuedouble == 7);
+    SL_CHECK(pj && fabs(cJSON_GetObjectItem(pj, "elapsed_ms")->valuedouble - 12.3) < 1e-9);
+    SL_CHECK(pj && !cJSON_GetObjectItem(pj, "ok") && !cJSON_GetObjectItem(pj, "frame"));
+    cJSON_Delete(pj);
+    free(pt);
+    pm.stage = SL_PROGRESS_DONE;
+    pm.fraction = 1;
+    pm.ok = 1;
+    pm.frame = 42;
+    pm.load_ms = 1000;
+    pm.prepare_ms = 250;
+    pm.render_ms = 80;
+    pt = sl_msg_progress_text(&pm);
+    pj = cJSON_Parse(pt);
+    SL_CHECK(pj && strcmp(cJSON_GetObjectItem(pj, "stage")->valuestring, "done") == 0);
+    SL_CHECK(pj && cJSON_GetObjectItem(pj, "fraction")->valuedouble == 1);
+    SL_CHECK(pj && cJSON_IsTrue(cJSON_GetObjectItem(pj, "ok")) && cJSON_GetObjectItem(pj, "frame")->valuedouble == 42);
+    SL_CHECK(pj && cJSON_GetObjectItem(pj, "load_ms")->valuedouble == 1000 &&
+             cJSON_GetObjectItem(pj, "prepare_ms")->valuedouble == 250 &&
+             cJSON_GetObjectItem(pj, "render_ms")->valuedouble == 80);
+    cJSON_Delete(pj);
+    free(pt);
+    SL_CHECK(strcmp(sl_progress_stage_name(SL_PROGRESS_FIRST_FRAME), "first_frame") == 0);
+
     /* stream settings: defaults, a patch, and all-or-nothing failures naming the key */
     sl_stream_settings ss = SL_STREAM_DEFAULTS;
     SL_CHECK(ss.interactive_scale == 1.0 && ss.interactive_adaptive == 1 && ss.interactive_budget_ms == 100);

@@ -235,37 +235,6 @@ static int reference_input(const sl_scene *scene, const char *data_dir, const sl
                                  size);
 }
 
-/* Explicit Hermite data inline ({"nodes":..}) or in a .json file; else the scene's own loader. */
-static sl_status open_dataset(const sl_scene *scene, const char *data_dir, sl_dataset **out, sl_err *err)
-{
-    if (sl_hermite_json_detect(scene->dataset))
-        return sl_hermite_dataset_from_json(scene->dataset, "inline", out, err);
-    if (cJSON_IsString(scene->dataset)) {
-        const char *name = scene->dataset->valuestring;
-        size_t n = strlen(name);
-        if (n > 5 && strcmp(name + n - 5, ".json") == 0) {
-            char path[4096];
-            if (name[0] != '/' && data_dir)
-                snprintf(path, sizeof path, "%s/%s", data_dir, name);
-            else
-                snprintf(path, sizeof path, "%s", name);
-            uint8_t *data = NULL;
-            size_t size = 0;
-            sl_status st = sl_read_file(path, 1u << 30, &data, &size, err);
-            if (st != SL_OK)
-                return st;
-            cJSON *root = cJSON_ParseWithLength((const char *)data, size);
-            int hermite = sl_hermite_json_detect(root);
-            cJSON_Delete(root);
-            if (hermite)
-                st = sl_load_hermite_json(data, size, path, out, err);
-            free(data);
-            if (hermite)
-                return st;
-        }
-    }
-    return sl_scene_open_dataset(scene, data_dir, out, err);
-}
 
 static char *read_text(const char *path)
 {
@@ -434,7 +403,7 @@ int main(int argc, char **argv)
     snprintf(scene_dir, sizeof scene_dir, "%s", o.scene);
     const char *data_dir = o.data_dir ? o.data_dir : dirname(scene_dir);
     sl_dataset *ds = NULL;
-    if (open_dataset(&scene, data_dir, &ds, &err) != SL_OK) {
+    if (sl_scene_open_dataset(&scene, data_dir, &ds, &err) != SL_OK) {
         fprintf(stderr, "tubes-check: dataset: %s\n", err.message);
         sl_scene_deinit(&scene);
         return 2;
@@ -527,7 +496,7 @@ int main(int argc, char **argv)
     } else {
         sl_dataset *copy = NULL;
         /* The pipeline owns its dataset: open a second copy for it. */
-        if (open_dataset(&scene, data_dir, &copy, &err) != SL_OK ||
+        if (sl_scene_open_dataset(&scene, data_dir, &copy, &err) != SL_OK ||
             render_gpu(copy, tech, &params, &view, gpu, o.out_png, &err) != SL_OK) {
             fprintf(stderr, "tubes-check: GPU: %s\n", err.message);
             rc = 3;

@@ -41,6 +41,7 @@
 
 #include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"
+#include "image/sl_diff.h"
 #include "pipeline/sl_pipeline.h"
 #include "voxel_lines/voxel_lines.h"
 
@@ -183,35 +184,32 @@ static int covered_pixel(const uint8_t *a, const uint8_t *b, size_t i, const flo
     return touched;
 }
 
-/* Max-channel |a - b| over the pixels either covers: mean and 99th
- * percentile (diff: n floats of scratch). Returns the covered count. */
-static size_t covered_diff(const uint8_t *a, const uint8_t *b, size_t n, const float bg[4], float *diff,
-                           double *mean, double *p99, double *max)
+/* Max-channel |a - b| over the pixels either covers (sl_diff_images_covered):
+ * mean, 99th percentile and max; INFINITY when none is covered. Returns the
+ * covered count. */
+static size_t covered_diff(const uint8_t *a, const uint8_t *b, int w, int h, const float bg[4], double *mean,
+                           double *p99, double *max)
 {
-    size_t covered = 0;
-    double sum = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        if (!covered_pixel(a, b, i, bg))
-            continue;
-        int m = 0;
-        for (int c = 0; c < 3; c++) {
-            int d = abs((int)a[4 * i + c] - (int)b[4 * i + c]);
-            m = d > m ? d : m;
-        }
-        diff[covered++] = (float)m;
-        sum += m;
+    uint8_t g[3];
+    for (int c = 0; c < 3; c++)
+        g[c] = (uint8_t)(bg[c] * 255.0f + 0.5f);
+    sl_image ia = {.width = w, .height = h, .rgba = (uint8_t *)a}, ib = {.width = w, .height = h, .rgba = (uint8_t *)b};
+    sl_diff_result r;
+    sl_err err;
+    if (sl_diff_images_covered(&ia, &ib, 8.0, g, &r, NULL, &err) != SL_OK || r.compared == 0) {
+        *mean = *p99 = *max = INFINITY;
+        return 0;
     }
-    qsort(diff, covered, sizeof *diff, cmp_float);
-    *mean = covered ? sum / (double)covered : INFINITY;
-    *p99 = covered ? diff[(size_t)(0.99 * (double)(covered - 1))] : INFINITY;
-    *max = covered ? diff[covered - 1] : INFINITY;
-    return covered;
+    *mean = r.mean_abs;
+    *p99 = r.p99_abs;
+    *max = r.max_abs;
+    return (size_t)r.compared;
 }
 
 /* voxel_lines vs lines_oit with the extra parameters in extra_bools (set by
  * the caller); prints and returns 0 when within the covered-pixel limits. */
 static int oit_pair(sl_pipeline *pipe, const options *o, const sl_view *view, double radius, const char *label,
-                    uint8_t *a, uint8_t *b, float *diff, sl_err *err)
+                    uint8_t *a, uint8_t *b, sl_err *err)
 {
     size_t n = (size_t)view->width * view->height;
     if (render(pipe, "lines_oit", o, radius, o->opacity, view, a, NULL, err) != SL_OK ||
@@ -220,7 +218,7 @@ static int oit_pair(sl_pipeline *pipe, const options *o, const sl_view *view, do
         return 3;
     }
     double mean, p99, max;
-    size_t covered = covered_diff(a, b, n, view->background, diff, &mean, &p99, &max);
+    size_t covered = covered_diff(a, b, view->width, view->height, view->background, &mean, &p99, &max);
     int ok = covered > n / 50 && mean <= o->tol_mean && p99 <= o->tol_p99;
     printf("%s: %zu of %zu pixels covered; over them max-channel |diff| mean %.3f p99 %.1f max %.0f "
            "(limits %.3f, %.1f) %s\n", label, covered, n, mean, p99, max, o->tol_mean, o->tol_p99,
@@ -232,14 +230,13 @@ static int check_oit(sl_pipeline *pipe, const options *o, const sl_view *view, d
 {
     size_t n = (size_t)view->width * view->height;
     uint8_t *a = calloc(n, 4), *b = calloc(n, 4);
-    float *diff = calloc(n, sizeof *diff);
     sl_err err = {0};
     int rc = 3;
-    if (!a || !b || !diff)
+    if (!a || !b)
         goto done;
     /* Constant opacity; the same with alpha termination at 0.5 in both (they
      * stop at the same fragment: the first that takes alpha to >= 0.5). */
-    rc = oit_pair(pipe, o, view, radius, "oit", a, b, diff, &err);
+    rc = oit_pair(pipe, o, view, radius, "oit", a, b, &err);
     if (rc == 3)
         goto done;
     size_t white_full = 0, white_capped = 0;
@@ -247,11 +244,11 @@ static int check_oit(sl_pipeline *pipe, const options *o, const sl_view *view, d
         white_full += a[4 * i] == 255 && a[4 * i + 1] == 255 && a[4 * i + 2] == 255;
     const char *half[2] = {"alpha_threshold=0.5", NULL};
     memcpy(extra_bools, half, sizeof half);
-    int r2 = oit_pair(pipe, o, view, radius, "oit alpha_threshold 0.5", a, b, diff, &err);
+    int r2 = oit_pair(pipe, o, view, radius, "oit alpha_threshold 0.5", a, b, &err);
     /* Opacity transfer function (ramp over the colour attribute): both agree too. */
     const char *ramp[3] = {"attribute=0", "opacity_transfer=1", NULL};
     memcpy(extra_bools, ramp, sizeof ramp);
-    int r3 = oit_pair(pipe, o, view, radius, "oit ramp", a, b, diff, &err);
+    int r3 = oit_pair(pipe, o, view, radius, "oit ramp", a, b, &err);
     extra_bools[0] = extra_bools[1] = NULL;
     rc = rc ? rc : (r2 ? r2 : r3);
     /* Overflow (Fig. 17): with room for only 2000 fragments the frame still
@@ -270,7 +267,6 @@ static int check_oit(sl_pipeline *pipe, const options *o, const sl_view *view, d
 done:
     free(a);
     free(b);
-    free(diff);
     return rc;
 }
 
@@ -597,10 +593,9 @@ static int check_tubes(sl_pipeline *pipe, const options *o, const sl_view *view,
 {
     size_t n = (size_t)view->width * view->height;
     uint8_t *a = calloc(n, 4), *b = calloc(n, 4), *c = calloc(n, 4);
-    float *diff = calloc(n, sizeof *diff);
     sl_err err = {0};
     int rc = 3;
-    if (!a || !b || !c || !diff)
+    if (!a || !b || !c)
         goto done;
     /* render() sets opacity only where the schema has it: tubes_mesh must. */
     const sl_technique *t = sl_technique_find("tubes_mesh");
@@ -642,7 +637,7 @@ static int check_tubes(sl_pipeline *pipe, const options *o, const sl_view *view,
         goto done;
     }
     double mean, p99, max;
-    size_t covered = covered_diff(a, b, n, view->background, diff, &mean, &p99, &max);
+    size_t covered = covered_diff(a, b, view->width, view->height, view->background, &mean, &p99, &max);
     int ok = covered > n / 50 && mean <= o->tol_mean && p99 <= o->tol_p99;
     printf("tubes_mesh at %.2f vs lines_oit: %zu pixels covered; max-channel |diff| mean %.3f p99 %.1f max %.0f "
            "(limits %.3f, %.1f) %s\n", o->opacity, covered, mean, p99, max, o->tol_mean, o->tol_p99, ok ? "ok" : "FAIL");
@@ -652,7 +647,6 @@ done:
     free(a);
     free(b);
     free(c);
-    free(diff);
     return rc;
 }
 
