@@ -1,11 +1,20 @@
 // controls.js — parameter controls generated from a technique's schema
 // (sl_params_schema_json: name, type, min, max, default, choices, unit,
-// description). float/int -> slider + value with unit, bool -> checkbox,
-// enum -> select (colormaps too), vec3 -> three number fields, attribute ->
-// select of the dataset's attribute names ("none" = -1 when min is -1).
-// Descriptions become tooltips; a slider also shows its range and unit
-// ("0 … 1000 world") beside the value and in its tooltip. Knows no
-// technique or parameter by name: the schema's type alone picks the control.
+// description). float/int -> slider + value with unit, or a number field
+// when the schema's range is too wide for a slider (max - min > 1e6:
+// `radius` 0 … 1e9, `scalar_min` ±1e30); bool -> checkbox; enum -> select
+// (colormaps too); vec3 with unit "rgb" -> a native colour input, any other
+// vec3 (directions, clip corners) -> three number fields clamped to
+// [min, max]; attribute -> select of the dataset's attribute names ("none" =
+// -1 when min is -1); transfer_function -> the editor of tf_editor.js.
+// Descriptions become tooltips; sliders and number fields also show their
+// range and unit ("0 … 1000 world"). Knows no technique or parameter by
+// name: the schema's type, range and unit alone pick the control.
+
+import { TransferFunctionEditor } from './tf_editor.js';
+
+// A schema range wider than this is typed, not slid.
+export const WIDE_RANGE = 1e6;
 
 function fmt(v, type) {
   if (type === 'int') return String(Math.round(v));
@@ -28,6 +37,28 @@ function scaleFor(def) {
   return {
     toSlider: (v) => v, fromSlider: (s) => Number(s),
     step: def.type === 'int' ? 1 : (hi - lo) / 200, min: lo, max: hi,
+  };
+}
+
+const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+
+// "#rrggbb" <-> [r, g, b] in 0..1.
+export function rgbToHex(v) {
+  const c = (x) => Math.round(clamp(Number(x) || 0, 0, 1) * 255).toString(16).padStart(2, '0');
+  return `#${c(v[0])}${c(v[1])}${c(v[2])}`;
+}
+export function hexToRgb(h) {
+  return [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16) / 255);
+}
+
+// Calls fn at most every `ms` (the first call at once, the last one always).
+export function throttle(fn, ms) {
+  let last = 0, timer = null, args = null;
+  return (...a) => {
+    args = a;
+    const wait = last + ms - performance.now();
+    if (wait <= 0) { last = performance.now(); fn(...args); return; }
+    if (!timer) timer = setTimeout(() => { timer = null; last = performance.now(); fn(...args); }, wait);
   };
 }
 
@@ -66,14 +97,18 @@ export class ParamControls {
   // attributes: the dataset's per-vertex attribute names in index order
   // (null while the catalog does not know them yet), the options of every
   // parameter of type 'attribute'.
-  build(schema, attributes = null) {
-    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes]);
+  // context: what the controls may know of the dataset, { valueRange: [lo, hi] | null }
+  // (a volume's value range, for transfer-function editors).
+  build(schema, attributes = null, context = {}) {
+    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes, context.valueRange || null]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     this.form.replaceChildren();
     this.inputs.clear();
+    this.context = context;
     for (const def of schema) {
-      const row = document.createElement('label');
+      // A label forwards clicks to its first input: not for the editor's canvas.
+      const row = document.createElement(def.type === 'transfer_function' ? 'div' : 'label');
       row.className = 'param';
       row.title = def.description || '';
       const name = document.createElement('span');
@@ -83,6 +118,29 @@ export class ParamControls {
       let entry;
       if (def.type === 'attribute') {
         entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
+      } else if ((def.type === 'float' || def.type === 'int') && def.max - def.min > WIDE_RANGE) {
+        const f = document.createElement('input');
+        f.type = 'number';
+        f.name = def.name;
+        f.step = def.type === 'int' ? '1' : 'any';
+        f.min = def.min; f.max = def.max;
+        f.className = 'num';
+        const unit = document.createElement('span');
+        unit.className = 'unit';
+        unit.textContent = def.unit || '';
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = `${fmt(def.min, def.type)} … ${fmt(def.max, def.type)}${def.unit ? ` ${def.unit}` : ''}`;
+        f.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
+        f.addEventListener('change', () => {
+          if (f.value === '' || !Number.isFinite(Number(f.value))) return;
+          let v = clamp(Number(f.value), def.min, def.max);
+          if (def.type === 'int') v = Math.round(v);
+          f.value = v;
+          this.onChange(def.name, v);
+        });
+        row.append(f, unit, range);
+        entry = { def, set: (v) => { f.value = v; } };
       } else if (def.type === 'float' || def.type === 'int') {
         const sc = scaleFor(def);
         const slider = document.createElement('input');
@@ -117,6 +175,20 @@ export class ParamControls {
         sel.addEventListener('change', () => this.onChange(def.name, sel.value));
         row.append(sel);
         entry = { def, set: (v) => { sel.value = v; } };
+      } else if (def.type === 'vec3' && def.unit === 'rgb') {
+        const pick = document.createElement('input');
+        pick.type = 'color';
+        pick.name = def.name;
+        pick.className = 'rgb';
+        const send = throttle((v) => this.onChange(def.name, v), 100);
+        pick.addEventListener('input', () => send(hexToRgb(pick.value)));
+        pick.addEventListener('change', () => send(hexToRgb(pick.value)));
+        row.append(pick);
+        entry = { def, set: (v) => { if (Array.isArray(v)) pick.value = rgbToHex(v); } };
+      } else if (def.type === 'transfer_function') {
+        const ed = new TransferFunctionEditor(row, def, (v) => this.onChange(def.name, v), this.context);
+        row.classList.add('tf');
+        entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'vec3') {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
@@ -128,7 +200,11 @@ export class ParamControls {
           return f;
         });
         for (const f of fields) {
-          f.addEventListener('change', () => this.onChange(def.name, fields.map((x) => Number(x.value))));
+          f.addEventListener('change', () => {
+            const v = fields.map((x) => clamp(Number(x.value) || 0, def.min, def.max));
+            fields.forEach((x, i) => { x.value = v[i]; });
+            this.onChange(def.name, v);
+          });
           row.append(f);
         }
         entry = { def, set: (v) => { fields.forEach((f, i) => { f.value = Array.isArray(v) ? v[i] : 0; }); } };
@@ -150,5 +226,6 @@ export class ParamControls {
 
   setEnabled(on) {
     for (const el of this.form.querySelectorAll('input, select')) el.disabled = !on;
+    for (const e of this.inputs.values()) if (e.editor) e.editor.setEnabled(on);
   }
 }
