@@ -12,9 +12,14 @@
 // WebSocket that joins the session on its own (no app.js) and reads the
 // server's full state from `welcome`, polled until it holds the expected
 // value (so a wrong value sent by the page times out and fails): checkbox,
-// enum, int and float sliders, vec3 fields, attribute selects (built from
-// the schema type alone; also checked on a synthetic schema), technique and
-// dataset pickers, "load view" (the saved view's dataset, technique, params
+// enum, int and float sliders, vec3 fields (clamped to the schema range), a
+// colour input (vec3 with unit "rgb"), number fields for ranges too wide for
+// a slider, attribute selects (built from the schema type alone; also
+// checked on a synthetic schema), technique and dataset pickers (the
+// technique picker lists only what renders the dataset's kind; picking a
+// volume switches to the first volume technique in one scene message and a
+// volume frame arrives), the transfer-function editor (a dragged opacity
+// point, throttled; a point's colour; a colormap preset), "load view" (the saved view's dataset, technique, params
 // and camera come back), and control hand-over to the second page (request,
 // grant, the new controller's change reaches the server, the old one's
 // controls are disabled). Screenshots go to <source>/build/ (CI artifact).
