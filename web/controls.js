@@ -2,7 +2,9 @@
 // (sl_params_schema_json: name, type, min, max, default, choices, unit,
 // description). float/int -> slider + value with unit, or a number field
 // when the schema's range is too wide for a slider (max - min > 1e6:
-// `radius` 0 … 1e9, `scalar_min` ±1e30); bool -> checkbox; enum -> select
+// `radius` 0 … 1e9, `scalar_min` ±1e30) — a slider over the dataset's value
+// range instead when the unit is "data" and a volume's range is known
+// (`isovalue`); bool -> checkbox; enum -> select
 // (colormaps too); vec3 with unit "rgb" -> a native colour input, any other
 // vec3 (directions, clip corners) -> three number fields clamped to
 // [min, max]; attribute -> select of the dataset's attribute names ("none" =
@@ -41,6 +43,14 @@ function scaleFor(def) {
 }
 
 const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+
+// The dataset's value range within the schema's, when the dataset is known and not constant.
+function dataRange(context, def) {
+  const r = context && context.valueRange;
+  if (!Array.isArray(r) || !(r[1] > r[0])) return null;
+  const lo = Math.max(r[0], def.min), hi = Math.min(r[1], def.max);
+  return hi > lo ? [lo, hi] : null;
+}
 
 // "#rrggbb" <-> [r, g, b] in 0..1.
 export function rgbToHex(v) {
@@ -118,6 +128,24 @@ export class ParamControls {
       let entry;
       if (def.type === 'attribute') {
         entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
+      } else if (def.type === 'float' && def.max - def.min > WIDE_RANGE && def.unit === 'data' &&
+                 dataRange(this.context, def)) {
+        // A value in data units: a slider over the dataset's own value range.
+        const [lo, hi] = dataRange(this.context, def);
+        const slider = document.createElement('input');
+        slider.type = 'range';
+        slider.name = def.name;
+        slider.min = lo; slider.max = hi; slider.step = 'any';
+        slider.dataset.over = 'dataset';
+        const out = document.createElement('output');
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = `${fmt(lo, 'float')} … ${fmt(hi, 'float')} data (the dataset's range)`;
+        slider.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
+        slider.addEventListener('input', () => { out.textContent = fmt(slider.value, 'float'); });
+        slider.addEventListener('change', () => this.onChange(def.name, Number(slider.value)));
+        row.append(slider, out, range);
+        entry = { def, set: (v) => { slider.value = v; out.textContent = fmt(v, 'float'); } };
       } else if ((def.type === 'float' || def.type === 'int') && def.max - def.min > WIDE_RANGE) {
         const f = document.createElement('input');
         f.type = 'number';

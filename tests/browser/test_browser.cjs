@@ -290,6 +290,24 @@ async function volumeScene(page, obs, sess, banner) {
   check((await banner()) === '', `no error after the switch to ${vds.name} (${await banner()})`);
   check(same(await options(), volume), `on a volume the technique picker offers ${JSON.stringify(await options())}`);
 
+  // A wide float in data units is a slider over the volume's own value range; End = its maximum.
+  await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.value_range), null, { timeout: T });
+  await page.waitForSelector('#params input[type=range][data-over=dataset]', { timeout: 5000 }).catch(() => {});
+  const vr = await page.evaluate(() => window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.value_range);
+  const vschema = await page.evaluate((n) => window.sightline.techniques.find((t) => t.name === n).params, volume[0]);
+  const dataParam = vschema.find((d) => d.type === 'float' && d.unit === 'data' && d.max - d.min > 1e6);
+  const sl = dataParam && await page.$eval(`#params input[type=range][name=${dataParam.name}]`,
+    (x) => [Number(x.min), Number(x.max)]).catch(() => null);
+  check(Array.isArray(vr) && sl && same(sl, vr), `${dataParam && dataParam.name} slides over the value range ${JSON.stringify(vr)}: ${JSON.stringify(sl)}`);
+  if (sl) {
+    await page.focus(`#params input[type=range][name=${dataParam.name}]`);
+    await page.keyboard.press('End');
+    check(await serverStateWhere(obs, sess, (s) => s.params[dataParam.name] === vr[1], `slider ${dataParam.name}`),
+      `${dataParam.name} = ${vr[1]} (the value range's maximum) on the server`);
+  }
+
   // Transfer-function editor: drag the last opacity point up to 60 % of the
   // canvas; the server's value keeps the colormap form with that opacity.
   const schema = await page.evaluate((n) => window.sightline.techniques.find((t) => t.name === n).params, volume[0]);
