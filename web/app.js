@@ -7,7 +7,8 @@
 // size, and the load, prepare, render and encode ms separately).
 // The session id and token live in the URL fragment (#session=..&token=..),
 // so a reload or a shared link joins the same session.
-// window.sightline exposes read-only counters for the browser test.
+// window.sightline exposes read-only counters (and the messages the page
+// sent, acks aside) for the browser test.
 
 import { Connection } from './protocol.js';
 import { CameraControl } from './camera.js';

@@ -13,7 +13,8 @@
 // range and unit ("0 … 1000 world"). Knows no technique or parameter by
 // name: the schema's type, range and unit alone pick the control.
 
-import { TransferFunctionEditor } from './tf_editor.js';
+import { TransferFunctionEditor, rgbToHex, hexToRgb } from './tf_editor.js';
+import { throttle } from './throttle.js';
 
 // A schema range wider than this is typed, not slid.
 export const WIDE_RANGE = 1e6;
@@ -52,25 +53,6 @@ function dataRange(context, def) {
   return hi > lo ? [lo, hi] : null;
 }
 
-// "#rrggbb" <-> [r, g, b] in 0..1.
-export function rgbToHex(v) {
-  const c = (x) => Math.round(clamp(Number(x) || 0, 0, 1) * 255).toString(16).padStart(2, '0');
-  return `#${c(v[0])}${c(v[1])}${c(v[2])}`;
-}
-export function hexToRgb(h) {
-  return [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16) / 255);
-}
-
-// Calls fn at most every `ms` (the first call at once, the last one always).
-export function throttle(fn, ms) {
-  let last = 0, timer = null, args = null;
-  return (...a) => {
-    args = a;
-    const wait = last + ms - performance.now();
-    if (wait <= 0) { last = performance.now(); fn(...args); return; }
-    if (!timer) timer = setTimeout(() => { timer = null; last = performance.now(); fn(...args); }, wait);
-  };
-}
 
 // A select of attribute names for one 'attribute' parameter; returns its
 // set(value). Names not known yet: only "none" and the current index, until
@@ -208,9 +190,9 @@ export class ParamControls {
         pick.type = 'color';
         pick.name = def.name;
         pick.className = 'rgb';
-        const send = throttle((v) => this.onChange(def.name, v), 100);
-        pick.addEventListener('input', () => send(hexToRgb(pick.value)));
-        pick.addEventListener('change', () => send(hexToRgb(pick.value)));
+        const send = throttle(() => this.onChange(def.name, hexToRgb(pick.value)), 100);
+        pick.addEventListener('input', () => send());
+        pick.addEventListener('change', () => send(true));
         row.append(pick);
         entry = { def, set: (v) => { if (Array.isArray(v)) pick.value = rgbToHex(v); } };
       } else if (def.type === 'transfer_function') {

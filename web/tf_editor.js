@@ -11,16 +11,19 @@
 // in the value. Changes are sent throttled (every 100 ms while dragging, the
 // last one always). No histogram: the server does not send one yet.
 
+import { throttle } from './throttle.js';
+
 const W = 256, H = 96, R = 5;   // canvas size (CSS scales it), point radius in canvas pixels
 const MAX_POINTS = 64;
 
 const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
 const lerp = (a, b, f) => a + (b - a) * f;
 
-function toHex(rgb) {
-  return `#${rgb.map((x) => Math.round(clamp(x, 0, 1) * 255).toString(16).padStart(2, '0')).join('')}`;
+// "#rrggbb" <-> [r, g, b] in 0..1 (native colour inputs; controls.js uses them too).
+export function rgbToHex(rgb) {
+  return `#${rgb.map((x) => Math.round(clamp(Number(x) || 0, 0, 1) * 255).toString(16).padStart(2, '0')).join('')}`;
 }
-function fromHex(h) {
+export function hexToRgb(h) {
   return [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16) / 255);
 }
 function fmt(v) {
@@ -39,7 +42,7 @@ export class TransferFunctionEditor {
     this.colormap = null;  // colormap form: its name
     this.range = null;     // [lo, hi] in data units, or null (the dataset's, not known here)
     this.selected = -1;
-    this.send = this.throttled(() => onChange(this.value()), 100);
+    this.send = throttle(() => onChange(this.value()), 100);
 
     const box = document.createElement('div');
     box.className = 'tf-editor';
@@ -66,7 +69,7 @@ export class TransferFunctionEditor {
     row.append(box);
 
     this.preset.addEventListener('change', () => this.applyPreset(this.preset.value));
-    this.color.addEventListener('input', () => this.recolour(fromHex(this.color.value)));
+    this.color.addEventListener('input', () => this.recolour(hexToRgb(this.color.value)));
     this.canvas.addEventListener('pointerdown', (e) => this.down(e));
     this.canvas.addEventListener('dblclick', (e) => this.add(e));
     this.canvas.addEventListener('keydown', (e) => {
@@ -76,17 +79,6 @@ export class TransferFunctionEditor {
         this.changed(true);
       }
     });
-  }
-
-  throttled(fn, ms) {
-    let last = 0, timer = null;
-    return (final) => {
-      clearTimeout(timer);
-      timer = null;
-      const wait = last + ms - performance.now();
-      if (final || wait <= 0) { last = performance.now(); fn(); return; }
-      timer = setTimeout(() => { timer = null; last = performance.now(); fn(); }, wait);
-    };
   }
 
   // The data range points are placed over: the value's own, else the dataset's.
@@ -232,7 +224,7 @@ export class TransferFunctionEditor {
   syncColour() {
     const p = this.points[this.selected];
     this.color.disabled = !p || (this.colormap && !this.span());
-    if (p) this.color.value = toHex(p.rgb || this.colourAt(p.t));
+    if (p) this.color.value = rgbToHex(p.rgb || this.colourAt(p.t));
   }
 
   setEnabled(on) {
