@@ -259,6 +259,25 @@ cJSON *sl_params_schema_json(const sl_param_def *schema, int count)
             for (int k = 0; d->choices[k]; k++)
                 cJSON_AddItemToArray(c, cJSON_CreateString(d->choices[k]));
         }
+        if (d->type == SL_PARAM_TRANSFER) {
+            /* The colormaps a value may name, each sampled at t = k / 16, so a
+             * client can draw and edit the colormap form without tables of its own. */
+            cJSON *maps = cJSON_AddArrayToObject(o, "colormaps");
+            for (int k = 0; sl_colormap_names[k]; k++) {
+                cJSON *m = cJSON_CreateObject();
+                cJSON_AddStringToObject(m, "name", sl_colormap_names[k]);
+                cJSON *colors = cJSON_AddArrayToObject(m, "colors");
+                for (int j = 0; j <= 16; j++) {
+                    float rgb[3];
+                    sl_colormap_sample(k, j / 16.0, rgb);
+                    double c[3];
+                    for (int i2 = 0; i2 < 3; i2++)
+                        c[i2] = round(rgb[i2] * 1000.0) / 1000.0;
+                    cJSON_AddItemToArray(colors, cJSON_CreateDoubleArray(c, 3));
+                }
+                cJSON_AddItemToArray(maps, m);
+            }
+        }
         cJSON_AddStringToObject(o, "unit", d->unit ? d->unit : "");
         cJSON_AddStringToObject(o, "description", d->description ? d->description : "");
         cJSON_AddStringToObject(o, "invalidates", invalidation_name(d->invalidates));

@@ -18,6 +18,7 @@
 
 #include <dirent.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -134,6 +135,9 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
     } else {
         cJSON_AddItemToObject(c, "dims", cJSON_CreateIntArray(ds->volume.dims, 3));
         cJSON_AddNumberToObject(c, "components", ds->volume.components);
+        double range[2] = {ds->volume.value_min, ds->volume.value_max};
+        if (isfinite(range[0]) && isfinite(range[1]))
+            cJSON_AddItemToObject(c, "value_range", cJSON_CreateDoubleArray(range, 2));
     }
     *bounds = cJSON_PrintUnformatted(b);
     *counts = cJSON_PrintUnformatted(c);

@@ -423,9 +423,19 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
         return;
     }
     if (!(t->dataset_kinds & (unsigned)next.dataset_kind)) {
-        char msg[300];
-        snprintf(msg, sizeof msg, "technique %s does not render %s datasets (dataset \"%.120s\")", t->name,
-                 sl_dataset_kind_name((sl_dataset_kind)next.dataset_kind), next.dataset);
+        /* Refused whole: the session keeps its state (nothing below ran). */
+        char kinds[64] = "";
+        const sl_dataset_kind all[] = {SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS};
+        for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+            if (t->dataset_kinds & (unsigned)all[i])
+                snprintf(kinds + strlen(kinds), sizeof kinds - strlen(kinds), "%s%s", kinds[0] ? ", " : "",
+                         sl_dataset_kind_name(all[i]));
+        char msg[512];
+        snprintf(msg, sizeof msg,
+                 "technique \"%s\" cannot render dataset \"%.100s\": it is a %s dataset and %s renders %s; "
+                 "the session keeps \"%.100s\" with \"%s\"",
+                 t->name, next.dataset, sl_dataset_kind_name((sl_dataset_kind)next.dataset_kind), t->name, kinds,
+                 s->state.dataset, s->state.technique);
         send_error(srv, c, "bad_field", msg, technique && technique[0] ? "technique" : "dataset");
         return;
     }

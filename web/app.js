@@ -7,7 +7,8 @@
 // size, and the load, prepare, render and encode ms separately).
 // The session id and token live in the URL fragment (#session=..&token=..),
 // so a reload or a shared link joins the same session.
-// window.sightline exposes read-only counters for the browser test.
+// window.sightline exposes read-only counters (and the messages the page
+// sent, acks aside) for the browser test.
 
 import { Connection } from './protocol.js';
 import { CameraControl } from './camera.js';
@@ -26,6 +27,16 @@ const conn = new Connection({
   width: 640,
   height: 480,
 });
+
+// Every message but `ack` the page sends, newest 1000 (window.sightline.sent, for the browser test).
+const sentLog = [];
+{
+  const send = conn.send.bind(conn);
+  conn.send = (msg) => {
+    if (msg.type !== 'ack') { sentLog.push(msg); if (sentLog.length > 1000) sentLog.shift(); }
+    return send(msg);
+  };
+}
 
 const app = {
   state: null,
@@ -46,6 +57,8 @@ window.sightline = {
   get lastFrame() { return app.lastFrame; },
   get state() { return app.state; },
   get techniques() { return app.techniques; },
+  get datasets() { return app.datasets; },
+  get sent() { return sentLog; },
   get clientId() { return app.clientId; },
   get cameraSeq() { return app.seq; },
   get cameraLimits() { return { maxElevation: camera.maxElevation, defaults: camera.defaults }; },
@@ -98,18 +111,36 @@ function attributeNames() {
   return Array.isArray(names) ? names : null;
 }
 
+// What the controls may know of the dataset beyond its attributes.
+function datasetContext() {
+  const r = datasetByName(app.state?.dataset)?.counts?.value_range;
+  return { valueRange: Array.isArray(r) ? r : null };
+}
+
 function buildParams() {
   const t = techniqueByName(app.state?.technique);
   if (!t) return;
-  params.build(t.params || [], attributeNames());
+  params.build(t.params || [], attributeNames(), datasetContext());
   params.update(app.state.params);
 }
 
+// The techniques whose dataset_kinds accept a dataset kind, in the server's order.
+function techniquesFor(kind) {
+  return app.techniques.filter((t) => (t.dataset_kinds || []).includes(kind));
+}
+
+// The dataset picker lists the catalog (a dataset no technique renders is
+// disabled); the technique picker only the techniques that accept the
+// session's dataset. Called again to show the session's choice after a refusal.
 function fillPickers() {
   const dsSel = $('dataset'), tSel = $('technique');
   dsSel.replaceChildren(...app.datasets.map((d) => {
     const o = new Option(`${d.name} (${d.kind})`, d.name);
     o.title = d.description || (d.source === 'file' ? `file, ${d.file_size ?? '?'} bytes` : 'generated');
+    if (!techniquesFor(d.kind).length) {
+      o.disabled = true;
+      o.title = `no technique renders ${d.kind} datasets`;
+    }
     return o;
   }));
   const kind = datasetByName(app.state?.dataset)?.kind;
@@ -277,6 +308,7 @@ conn.addEventListener('message', (ev) => {
       break;
     case 'error':
       if (msg.code === 'load_failed') progress.hide();
+      if (msg.field === 'dataset' || msg.field === 'technique') fillPickers();   // back to the session's pair
       setBanner(`${msg.code}: ${msg.message}${msg.field ? ` (${msg.field})` : ''}`);
       setTimeout(() => { if ($('banner').textContent.startsWith(msg.code)) setBanner(''); }, 4000);
       break;
@@ -295,13 +327,17 @@ conn.addEventListener('disconnect', () => {
   setBanner('Disconnected from the server — reconnecting to the same session…');
 });
 
+// A dataset of a kind the current technique does not render brings the
+// first technique that does, in the same scene message: the server never
+// sees an unfit pair from the page.
 $('dataset').addEventListener('change', (e) => {
   const kind = datasetByName(e.target.value)?.kind;
   const current = techniqueByName(app.state?.technique);
   const msg = { type: 'scene', dataset: e.target.value };
-  if (current && kind && !(current.dataset_kinds || []).includes(kind)) {
-    const t = app.techniques.find((x) => (x.dataset_kinds || []).includes(kind));
-    if (t) msg.technique = t.name;
+  if (kind && !(current?.dataset_kinds || []).includes(kind)) {
+    const t = techniquesFor(kind)[0];
+    if (!t) { fillPickers(); setBanner(`no technique renders ${kind} datasets`); return; }
+    msg.technique = t.name;
   }
   conn.send(msg);
 });

@@ -1,11 +1,23 @@
 // controls.js — parameter controls generated from a technique's schema
 // (sl_params_schema_json: name, type, min, max, default, choices, unit,
-// description). float/int -> slider + value with unit, bool -> checkbox,
-// enum -> select (colormaps too), vec3 -> three number fields, attribute ->
-// select of the dataset's attribute names ("none" = -1 when min is -1).
-// Descriptions become tooltips; a slider also shows its range and unit
-// ("0 … 1000 world") beside the value and in its tooltip. Knows no
-// technique or parameter by name: the schema's type alone picks the control.
+// description). float/int -> slider + value with unit, or a number field
+// when the schema's range is too wide for a slider (max - min > 1e6:
+// `radius` 0 … 1e9, `scalar_min` ±1e30) — a slider over the dataset's value
+// range instead when the unit is "data" and a volume's range is known
+// (`isovalue`); bool -> checkbox; enum -> select
+// (colormaps too); vec3 with unit "rgb" -> a native colour input, any other
+// vec3 (directions, clip corners) -> three number fields clamped to
+// [min, max]; attribute -> select of the dataset's attribute names ("none" =
+// -1 when min is -1); transfer_function -> the editor of tf_editor.js.
+// Descriptions become tooltips; sliders and number fields also show their
+// range and unit ("0 … 1000 world"). Knows no technique or parameter by
+// name: the schema's type, range and unit alone pick the control.
+
+import { TransferFunctionEditor, rgbToHex, hexToRgb } from './tf_editor.js';
+import { throttle } from './throttle.js';
+
+// A schema range wider than this is typed, not slid.
+export const WIDE_RANGE = 1e6;
 
 function fmt(v, type) {
   if (type === 'int') return String(Math.round(v));
@@ -30,6 +42,17 @@ function scaleFor(def) {
     step: def.type === 'int' ? 1 : (hi - lo) / 200, min: lo, max: hi,
   };
 }
+
+const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+
+// The dataset's value range within the schema's, when the dataset is known and not constant.
+function dataRange(context, def) {
+  const r = context && context.valueRange;
+  if (!Array.isArray(r) || !(r[1] > r[0])) return null;
+  const lo = Math.max(r[0], def.min), hi = Math.min(r[1], def.max);
+  return hi > lo ? [lo, hi] : null;
+}
+
 
 // A select of attribute names for one 'attribute' parameter; returns its
 // set(value). Names not known yet: only "none" and the current index, until
@@ -66,14 +89,18 @@ export class ParamControls {
   // attributes: the dataset's per-vertex attribute names in index order
   // (null while the catalog does not know them yet), the options of every
   // parameter of type 'attribute'.
-  build(schema, attributes = null) {
-    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes]);
+  // context: what the controls may know of the dataset, { valueRange: [lo, hi] | null }
+  // (a volume's value range, for transfer-function editors).
+  build(schema, attributes = null, context = {}) {
+    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes, context.valueRange || null]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     this.form.replaceChildren();
     this.inputs.clear();
+    this.context = context;
     for (const def of schema) {
-      const row = document.createElement('label');
+      // A label forwards clicks to its first input: not for the editor's canvas.
+      const row = document.createElement(def.type === 'transfer_function' ? 'div' : 'label');
       row.className = 'param';
       row.title = def.description || '';
       const name = document.createElement('span');
@@ -83,6 +110,47 @@ export class ParamControls {
       let entry;
       if (def.type === 'attribute') {
         entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
+      } else if (def.type === 'float' && def.max - def.min > WIDE_RANGE && def.unit === 'data' &&
+                 dataRange(this.context, def)) {
+        // A value in data units: a slider over the dataset's own value range.
+        const [lo, hi] = dataRange(this.context, def);
+        const slider = document.createElement('input');
+        slider.type = 'range';
+        slider.name = def.name;
+        slider.min = lo; slider.max = hi; slider.step = 'any';
+        slider.dataset.over = 'dataset';
+        const out = document.createElement('output');
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = `${fmt(lo, 'float')} … ${fmt(hi, 'float')} data (the dataset's range)`;
+        slider.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
+        slider.addEventListener('input', () => { out.textContent = fmt(slider.value, 'float'); });
+        slider.addEventListener('change', () => this.onChange(def.name, Number(slider.value)));
+        row.append(slider, out, range);
+        entry = { def, set: (v) => { slider.value = v; out.textContent = fmt(v, 'float'); } };
+      } else if ((def.type === 'float' || def.type === 'int') && def.max - def.min > WIDE_RANGE) {
+        const f = document.createElement('input');
+        f.type = 'number';
+        f.name = def.name;
+        f.step = def.type === 'int' ? '1' : 'any';
+        f.min = def.min; f.max = def.max;
+        f.className = 'num';
+        const unit = document.createElement('span');
+        unit.className = 'unit';
+        unit.textContent = def.unit || '';
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = `${fmt(def.min, def.type)} … ${fmt(def.max, def.type)}${def.unit ? ` ${def.unit}` : ''}`;
+        f.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
+        f.addEventListener('change', () => {
+          if (f.value === '' || !Number.isFinite(Number(f.value))) return;
+          let v = clamp(Number(f.value), def.min, def.max);
+          if (def.type === 'int') v = Math.round(v);
+          f.value = v;
+          this.onChange(def.name, v);
+        });
+        row.append(f, unit, range);
+        entry = { def, set: (v) => { f.value = v; } };
       } else if (def.type === 'float' || def.type === 'int') {
         const sc = scaleFor(def);
         const slider = document.createElement('input');
@@ -117,6 +185,20 @@ export class ParamControls {
         sel.addEventListener('change', () => this.onChange(def.name, sel.value));
         row.append(sel);
         entry = { def, set: (v) => { sel.value = v; } };
+      } else if (def.type === 'vec3' && def.unit === 'rgb') {
+        const pick = document.createElement('input');
+        pick.type = 'color';
+        pick.name = def.name;
+        pick.className = 'rgb';
+        const send = throttle(() => this.onChange(def.name, hexToRgb(pick.value)), 100);
+        pick.addEventListener('input', () => send());
+        pick.addEventListener('change', () => send(true));
+        row.append(pick);
+        entry = { def, set: (v) => { if (Array.isArray(v)) pick.value = rgbToHex(v); } };
+      } else if (def.type === 'transfer_function') {
+        const ed = new TransferFunctionEditor(row, def, (v) => this.onChange(def.name, v), this.context);
+        row.classList.add('tf');
+        entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'vec3') {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
@@ -128,7 +210,11 @@ export class ParamControls {
           return f;
         });
         for (const f of fields) {
-          f.addEventListener('change', () => this.onChange(def.name, fields.map((x) => Number(x.value))));
+          f.addEventListener('change', () => {
+            const v = fields.map((x) => clamp(Number(x.value) || 0, def.min, def.max));
+            fields.forEach((x, i) => { x.value = v[i]; });
+            this.onChange(def.name, v);
+          });
           row.append(f);
         }
         entry = { def, set: (v) => { fields.forEach((f, i) => { f.value = Array.isArray(v) ? v[i] : 0; }); } };
@@ -150,5 +236,6 @@ export class ParamControls {
 
   setEnabled(on) {
     for (const el of this.form.querySelectorAll('input, select')) el.disabled = !on;
+    for (const e of this.inputs.values()) if (e.editor) e.editor.setEnabled(on);
   }
 }

@@ -12,9 +12,14 @@
 // WebSocket that joins the session on its own (no app.js) and reads the
 // server's full state from `welcome`, polled until it holds the expected
 // value (so a wrong value sent by the page times out and fails): checkbox,
-// enum, int and float sliders, vec3 fields, attribute selects (built from
-// the schema type alone; also checked on a synthetic schema), technique and
-// dataset pickers, "load view" (the saved view's dataset, technique, params
+// enum, int and float sliders, vec3 fields (clamped to the schema range), a
+// colour input (vec3 with unit "rgb"), number fields for ranges too wide for
+// a slider, attribute selects (built from the schema type alone; also
+// checked on a synthetic schema), technique and dataset pickers (the
+// technique picker lists only what renders the dataset's kind; picking a
+// volume switches to the first volume technique in one scene message and a
+// volume frame arrives), the transfer-function editor (a dragged opacity
+// point, throttled; a point's colour; a colormap preset), "load view" (the saved view's dataset, technique, params
 // and camera come back), and control hand-over to the second page (request,
 // grant, the new controller's change reaches the server, the old one's
 // controls are disabled). Screenshots go to <source>/build/ (CI artifact).
@@ -157,14 +162,15 @@ async function driveControls(page, obs, sess, saved) {
     `int slider ${int.name} = ${int.max - 1} (max - 1) on the server`);
   // Float slider (linear scale) by keyboard: Home = min exactly.
   const log = (d) => d.min >= 0 && d.max > 1000 * Math.max(d.min, 1e-6);
-  const flt = schema.find((d) => d.type === 'float' && !log(d) && d.default !== d.min);
+  const flt = schema.find((d) => d.type === 'float' && !log(d) && d.max - d.min <= 1e6 && d.default !== d.min);
   await page.focus(`#params input[type=range][name=${flt.name}]`);
   await page.keyboard.press('Home');
   check(await serverStateWhere(obs, sess, (s) => s.params[flt.name] === flt.min, `float slider ${flt.name}`),
     `float slider ${flt.name} = ${flt.min} (min) on the server`);
 
-  // Vector: three typed components, each committed with Tab.
-  const vec = schema.find((d) => d.type === 'vec3' && d.min <= 0.25 && d.max >= 0.75);
+  // Vector (not a colour): three typed components, each committed with Tab;
+  // a component beyond the schema's range is clamped to it before it is sent.
+  const vec = schema.find((d) => d.type === 'vec3' && d.unit !== 'rgb' && d.min <= 0.25 && d.max >= 0.75);
   const want = [0.25, 0.5, 0.75];
   const fields = page.locator(`#params input.vec[name=${vec.name}]`);
   check((await fields.count()) === 3, `vec3 ${vec.name} has three fields`);
@@ -174,6 +180,35 @@ async function driveControls(page, obs, sess, saved) {
   }
   check(await serverStateWhere(obs, sess, (s) => same(s.params[vec.name], want), `vec3 ${vec.name}`),
     `vec3 ${vec.name} = ${JSON.stringify(want)} on the server`);
+  await fields.nth(0).fill(String(vec.max + 4));
+  await fields.nth(0).press('Tab');
+  const clamped = [vec.max, want[1], want[2]];
+  check(await serverStateWhere(obs, sess, (s) => same(s.params[vec.name], clamped), `vec3 ${vec.name} clamped`),
+    `vec3 ${vec.name} typed ${vec.max + 4} = ${JSON.stringify(clamped)} (clamped) on the server`);
+
+  // Colour (vec3 with unit "rgb"): a native colour input; #336699 reaches the server as 0x33/255 ...
+  const rgb = schema.find((d) => d.type === 'vec3' && d.unit === 'rgb');
+  check(rgb && (await page.locator(`#params input[type=color][name=${rgb.name}]`).count()) === 1 &&
+    (await page.locator(`#params input.vec[name=${rgb.name}]`).count()) === 0, `${rgb && rgb.name} is a colour input`);
+  await page.locator(`#params input[type=color][name=${rgb.name}]`).fill('#336699');
+  const wantRgb = [0x33 / 255, 0x66 / 255, 0x99 / 255];
+  check(await serverStateWhere(obs, sess, (s) => s.params[rgb.name].every((x, k) => Math.abs(x - wantRgb[k]) < 1e-6),
+    `colour ${rgb.name}`), `colour ${rgb.name} #336699 = ${JSON.stringify(wantRgb.map((x) => x.toFixed(3)))} on the server`);
+
+  // A range too wide for a slider (max - min > 1e6) is a number field: every such
+  // parameter has one and no slider; a typed value reaches the server as typed.
+  const wide = schema.filter((d) => (d.type === 'float' || d.type === 'int') && d.max - d.min > 1e6);
+  check(wide.length >= 2, `${schema.length} parameters include wide ranges ${wide.map((d) => d.name)}`);
+  for (const d of wide) {
+    check((await page.locator(`#params input[type=number][name=${d.name}]`).count()) === 1 &&
+      (await page.locator(`#params input[type=range][name=${d.name}]`).count()) === 0,
+    `${d.name} (${d.min} … ${d.max}) is a number field, not a slider`);
+  }
+  const num = wide.find((d) => d.type === 'float' && d.min <= 0.0125 && d.max >= 0.0125);
+  await page.fill(`#params input[type=number][name=${num.name}]`, '0.0125');
+  await page.press(`#params input[type=number][name=${num.name}]`, 'Enter');
+  check(await serverStateWhere(obs, sess, (s) => s.params[num.name] === 0.0125, `number ${num.name}`),
+    `number field ${num.name} = 0.0125 on the server`);
 
   // Attribute selects: built for every 'attribute' parameter, listing the
   // dataset's attribute names (from the server's catalog) after "none".
@@ -216,12 +251,111 @@ async function driveControls(page, obs, sess, saved) {
   await settled(page);
   check((await banner()) === '', `no error after the dataset switch (${await banner()})`);
 
+  // The technique picker offers only what renders the dataset's kind; a
+  // dataset of another kind switches to the first technique that accepts it,
+  // in one scene message (no error), and a frame of it arrives.
+  await volumeScene(page, obs, sess, banner);
+
   // Load view: the saved view's dataset, technique, params and camera return.
   await page.selectOption('#views', saved.name);
   await page.click('#load-view');
   st = await serverStateWhere(obs, sess, (s) => s.dataset === saved.state.dataset && s.technique === saved.state.technique &&
     same(s.params, saved.state.params) && same(s.camera, saved.state.camera), 'load view');
   check(st, `load view "${saved.name}" restored ${saved.state.dataset}/${saved.state.technique}, params and camera`);
+  await settled(page);
+}
+
+// Pickers that know what fits, a volume frame, and the transfer-function editor.
+async function volumeScene(page, obs, sess, banner) {
+  const info = await page.evaluate(() => ({ techniques: window.sightline.techniques.map((t) => ({ name: t.name,
+    kinds: t.dataset_kinds })), datasets: window.sightline.datasets.map((d) => ({ name: d.name, kind: d.kind })) }));
+  const accepting = (kind) => info.techniques.filter((t) => t.kinds.includes(kind)).map((t) => t.name);
+  const options = () => page.$$eval('#technique option', (os) => os.map((o) => o.value));
+  const lines = accepting('lines'), volume = accepting('volume');
+  check(lines.length && volume.length && !lines.every((n) => volume.includes(n)), `lines ${lines}, volume ${volume}`);
+  check(same(await options(), lines), `on a line set the technique picker offers ${JSON.stringify(await options())}`);
+  const vds = info.datasets.find((d) => d.name === 'marschner_lobb') || info.datasets.find((d) => d.kind === 'volume');
+  const sentBefore = await page.evaluate(() => window.sightline.sent.length);
+  await page.selectOption('#dataset', vds.name);
+  const st = await serverStateWhere(obs, sess, (s) => s.dataset === vds.name && Array.isArray(s.bounds), 'volume dataset', 60000);
+  check(st && st.technique === volume[0], `${vds.name} brought technique ${volume[0]} (${st && st.technique})`);
+  const scenes = await page.evaluate((n) => window.sightline.sent.slice(n).filter((m) => m.type === 'scene'), sentBefore);
+  check(scenes.length === 1 && scenes[0].dataset === vds.name && scenes[0].technique === volume[0],
+    `one scene message with both: ${JSON.stringify(scenes)}`);
+  await page.waitForFunction((n) => window.sightline.state.technique === n, volume[0], { timeout: T });
+  await page.waitForFunction(() => window.sightline.lastFrame && !window.sightline.lastFrame.interactive &&
+    window.sightline.lastFrame.stateVersion >= window.sightline.stateVersion, null, { timeout: 3 * T });
+  const fr = await canvasStats(page);
+  check(fr.fg > 0.05 && fr.fg < 0.95, `a volume frame arrived (foreground ${fr.fg.toFixed(3)})`);
+  check((await banner()) === '', `no error after the switch to ${vds.name} (${await banner()})`);
+  check(same(await options(), volume), `on a volume the technique picker offers ${JSON.stringify(await options())}`);
+
+  // A wide float in data units is a slider over the volume's own value range; End = its maximum.
+  await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.value_range), null, { timeout: T });
+  await page.waitForSelector('#params input[type=range][data-over=dataset]', { timeout: 5000 }).catch(() => {});
+  const vr = await page.evaluate(() => window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.value_range);
+  const vschema = await page.evaluate((n) => window.sightline.techniques.find((t) => t.name === n).params, volume[0]);
+  const dataParam = vschema.find((d) => d.type === 'float' && d.unit === 'data' && d.max - d.min > 1e6);
+  const sl = dataParam && await page.$eval(`#params input[type=range][name=${dataParam.name}]`,
+    (x) => [Number(x.min), Number(x.max)]).catch(() => null);
+  check(Array.isArray(vr) && sl && same(sl, vr), `${dataParam && dataParam.name} slides over the value range ${JSON.stringify(vr)}: ${JSON.stringify(sl)}`);
+  if (sl) {
+    await page.focus(`#params input[type=range][name=${dataParam.name}]`);
+    await page.keyboard.press('End');
+    check(await serverStateWhere(obs, sess, (s) => s.params[dataParam.name] === vr[1], `slider ${dataParam.name}`),
+      `${dataParam.name} = ${vr[1]} (the value range's maximum) on the server`);
+  }
+
+  // Transfer-function editor: drag the last opacity point up to 60 % of the
+  // canvas; the server's value keeps the colormap form with that opacity.
+  const schema = await page.evaluate((n) => window.sightline.techniques.find((t) => t.name === n).params, volume[0]);
+  const tfDef = schema.find((d) => d.type === 'transfer_function');
+  const cv = page.locator(`#params canvas[data-param=${tfDef.name}]`);
+  check((await cv.count()) === 1, `${tfDef.name} has an editor canvas`);
+  await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.value_range), null, { timeout: T });
+  const tf0 = st.params[tfDef.name];
+  const last = tf0.opacity.length - 1;
+  let box = await cv.boundingBox();
+  const at = (t, a) => [box.x + Math.min(t * box.width, box.width - 1), box.y + (1 - a) * box.height];
+  await page.evaluate(() => { window.sightline.sent.length = 0; });
+  const [x0, y0] = at(tf0.opacity[last][0], tf0.opacity[last][1]);
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  for (let i = 1; i <= 20; i++) await page.mouse.move(x0, y0 + (at(1, 0.6)[1] - y0) * i / 20);
+  await page.mouse.up();
+  const moved = await serverStateWhere(obs, sess, (s) => {
+    const v = s.params[tfDef.name];
+    return v && v.colormap === tf0.colormap && Math.abs(v.opacity[last][1] - 0.6) < 0.03;
+  }, 'tf drag');
+  check(moved, `dragged point ${last} reached the server: opacity ${JSON.stringify(moved && moved.params[tfDef.name].opacity)}`);
+  const tfSets = await page.evaluate((n) => window.sightline.sent.filter((m) => m.type === 'set' && m.params &&
+    n in m.params).length, tfDef.name);
+  check(tfSets >= 1 && tfSets < 20, `a 20-step drag sent ${tfSets} throttled set messages`);
+
+  // A colour for the selected point: the value becomes points in data units.
+  const range = await page.evaluate(() => window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset).counts.value_range);
+  box = await cv.boundingBox();
+  await page.mouse.click(...at(1, 0.6));
+  await page.locator(`#params input[type=color][name="${tfDef.name}.color"]`).fill('#ff0000');
+  const coloured = await serverStateWhere(obs, sess, (s) => {
+    const v = s.params[tfDef.name];
+    const p = Array.isArray(v) && v[v.length - 1];
+    return p && Math.abs(p[0] - range[1]) <= 0.01 * (range[1] - range[0]) && p[1] === 1 && p[2] === 0 &&
+      p[3] === 0 && Math.abs(p[4] - 0.6) < 0.03;
+  }, 'tf colour');
+  check(coloured, `point ${last} coloured #ff0000 at value ${range[1]} on the server`);
+  await settled(page);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
+
+  // A preset: back to the colormap form with that colormap.
+  const preset = tfDef.colormaps.find((m) => m.name !== tf0.colormap).name;
+  await page.selectOption(`#params select[name="${tfDef.name}.preset"]`, preset);
+  check(await serverStateWhere(obs, sess, (s) => s.params[tfDef.name].colormap === preset, 'tf preset'),
+    `preset ${preset} on the server`);
   await settled(page);
 }
 
@@ -238,7 +372,25 @@ async function synthetic(page) {
       { name: 'zz_pick', type: 'attribute', min: -1, max: 31, default: 0, unit: '', description: '' },
       { name: 'zz_strict', type: 'attribute', min: 0, max: 31, default: 0, unit: '', description: '' },
       { name: 'attribute', type: 'int', min: -1, max: 31, default: 0, unit: '', description: '' },
+      { name: 'zz_tint', type: 'vec3', min: 0, max: 1, default: [1, 0, 0], unit: 'rgb', description: '' },
+      { name: 'zz_dir', type: 'vec3', min: -1, max: 1, default: [0, 0, 1], unit: '', description: '' },
+      { name: 'zz_huge', type: 'float', min: -1e30, max: 1e30, default: 0, unit: '', description: '' },
+      { name: 'zz_small', type: 'float', min: 0, max: 1e6, default: 0, unit: '', description: '' },
     ], ['p', 'q']);
+    pc.update({ zz_dir: [0, 0, 1] });
+    const kinds = {
+      tint: form.querySelector('input[name=zz_tint]')?.type,
+      dir: form.querySelectorAll('input.vec[name=zz_dir]').length,
+      huge: form.querySelector('input[name=zz_huge]')?.type,
+      small: form.querySelector('input[name=zz_small]')?.type,
+    };
+    const dir = form.querySelectorAll('input.vec[name=zz_dir]');
+    dir[0].value = '7';
+    dir[0].dispatchEvent(new Event('change'));
+    const huge = form.querySelector('input[name=zz_huge]');
+    huge.value = '-3e31';
+    huge.dispatchEvent(new Event('change'));
+    const controlKinds = { kinds, sent: sent.splice(0) };
     pc.update({ zz_pick: 1, zz_strict: 0, attribute: 3 });
     const pick = form.querySelector('select[name=zz_pick]');
     const strict = form.querySelector('select[name=zz_strict]');
@@ -248,13 +400,17 @@ async function synthetic(page) {
     pick.dispatchEvent(new Event('change'));
     strict.value = '1';
     strict.dispatchEvent(new Event('change'));
-    return { pick: opts(pick), strict: opts(strict), shown, sent,
+    return { pick: opts(pick), strict: opts(strict), shown, sent, controlKinds,
       intIsSlider: !!form.querySelector('input[type=range][name=attribute]') };
   });
   check(same(r.pick, ['none', 'p', 'q']) && r.shown === '1', `synthetic attribute select ${JSON.stringify(r)}`);
   check(same(r.strict, ['p', 'q']), `an attribute with min 0 has no "none" ${JSON.stringify(r.strict)}`);
   check(same(r.sent, [['zz_pick', -1], ['zz_strict', 1]]), `attribute selects send indices ${JSON.stringify(r.sent)}`);
   check(r.intIsSlider, 'an int parameter named "attribute" is a slider');
+  const ck = r.controlKinds;
+  check(same(ck.kinds, { tint: 'color', dir: 3, huge: 'number', small: 'range' }),
+    `synthetic rgb / direction / ±1e30 / 0…1e6 controls ${JSON.stringify(ck.kinds)}`);
+  check(same(ck.sent, [['zz_dir', [1, 0, 1]], ['zz_huge', -1e30]]), `typed values are clamped ${JSON.stringify(ck.sent)}`);
 }
 
 // Control hand-over: the viewer asks, the controller grants, the server says

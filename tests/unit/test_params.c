@@ -218,6 +218,25 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
                  cJSON_GetArraySize(op) == 2 &&
                  cJSON_GetArrayItem(cJSON_GetArrayItem(op, 0), 1)->valuedouble == d->def[1] &&
                  cJSON_GetArrayItem(cJSON_GetArrayItem(op, 1), 1)->valuedouble == d->def[2];
+        /* colormaps: every name a value may take, in order, each with 17 colours; the
+         * middle one is sl_colormap_sample at t = 0.5 (to 1e-3). */
+        const cJSON *maps = cJSON_GetObjectItemCaseSensitive(o, "colormaps");
+        int k = 0, maps_ok = cJSON_IsArray(maps);
+        const cJSON *m;
+        cJSON_ArrayForEach(m, maps) {
+            const cJSON *mn = cJSON_GetObjectItemCaseSensitive(m, "name");
+            const cJSON *colors = cJSON_GetObjectItemCaseSensitive(m, "colors");
+            float mid[3];
+            maps_ok = maps_ok && sl_colormap_names[k] && cJSON_IsString(mn) &&
+                      strcmp(mn->valuestring, sl_colormap_names[k]) == 0 && cJSON_GetArraySize(colors) == 17;
+            if (!maps_ok)
+                break;
+            sl_colormap_sample(k, 0.5, mid);
+            for (int c = 0; c < 3; c++)
+                maps_ok = maps_ok && fabs(cJSON_GetArrayItem(cJSON_GetArrayItem(colors, 8), c)->valuedouble - mid[c]) <= 1e-3;
+            k++;
+        }
+        SL_CHECK_MSG(maps_ok && !sl_colormap_names[k], "%s.%s: schema JSON colormaps (%d listed)", tech, d->name, k);
         break;
     }
     }
