@@ -81,11 +81,7 @@ static uint32_t wait_dataset_patch(tclient *c, const char *name, int *errors)
 int main(void)
 {
     harness h;
-    if (harness_start(&h, NULL) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, NULL);
     char data[400], obj[512];
     snprintf(data, sizeof data, "%s/data", h.dir);
     snprintf(obj, sizeof obj, "%s/lines.obj", data);

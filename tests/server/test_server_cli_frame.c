@@ -157,11 +157,7 @@ static void run_case(const harness *h, tclient *c, const scene_case *sc, int neg
 int main(void)
 {
     harness h;
-    if (harness_start(&h, NULL) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, NULL);
     tclient c;
     if (tclient_connect(&c, h.port, NULL) != 0 || tclient_hello(&c, NULL, NULL, W, H) != 0) {
         SL_CHECK(!"connected");

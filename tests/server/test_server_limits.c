@@ -198,11 +198,7 @@ int main(void)
 {
     harness h;
     const char *extra[] = {"--max-sessions", "2", "--grace", "60", NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
     max_sessions(&h);
     /* Both sessions now have no client; resize_and_quality's session evicts the older. */
     resize_and_quality(&h);

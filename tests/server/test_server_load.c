@@ -308,11 +308,7 @@ int main(void)
     /* 16 clients connect at once, all from 127.0.0.1: above the default pending
      * cap of one address (--max-pending-per-address 4), which would refuse most. */
     const char *extra[] = {"--max-pending", "32", "--max-pending-per-address", "32", NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
     pthread_barrier_t barrier;
     pthread_barrier_init(&barrier, NULL, CLIENTS + 1);
     worker w[CLIENTS];

@@ -46,11 +46,7 @@ int main(void)
     harness_small_asan_quarantine();
     harness h;
     const char *extra[] = {"--default-dataset", "tornado", "--idle-release", "1", NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
     long start = harness_rss_kib(h.pid);
 
     tclient warm;

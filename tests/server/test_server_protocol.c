@@ -220,11 +220,7 @@ int main(void)
 {
     harness h;
     const char *extra[] = {"--grace", "2", "--hello-timeout", "2", "--allow-origin", "https://viz.example.org", NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
     printf("server on port %d\n", h.port);
 
     /* --- hello / welcome --- */

@@ -96,11 +96,7 @@ static void expect_refused(tclient *a, const char *msg, const char *dataset, con
 int main(void)
 {
     harness h;
-    if (harness_start(&h, NULL) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, NULL);
     tclient a;
     SL_CHECK(tclient_connect(&a, h.port, NULL) == 0);
     SL_CHECK(tclient_hello(&a, NULL, NULL, 64, 48) == 0);

@@ -173,11 +173,7 @@ int main(void)
     snprintf(ht, sizeof ht, "%d", HELLO_TIMEOUT_S);
     const char *extra[] = {"--max-clients", mc, "--max-pending", mp, "--max-pending-per-address", pa,
                            "--hello-timeout", ht, NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
 
     /* --- the per-address cap: two silent upgrades from 127.0.0.2, the third refused;
      *     127.0.0.1 is another address and still gets in --- */

@@ -148,11 +148,7 @@ int main(void)
 {
     harness h;
     const char *extra[] = {"--test-load-delay-ms", "2000", NULL};
-    if (harness_start(&h, extra) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, extra);
     tclient a, c;
     SL_CHECK(tclient_connect(&a, h.port, NULL) == 0 && tclient_hello(&a, NULL, NULL, W, H) == 0);
     a.auto_ack = 1;

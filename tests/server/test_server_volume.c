@@ -54,11 +54,7 @@ static uint32_t wait_technique(tclient *c)
 int main(void)
 {
     harness h;
-    if (harness_start(&h, NULL) != 0) {
-        SL_CHECK(!"server started");
-        harness_stop(&h);
-        SL_TEST_END();
-    }
+    HARNESS_START_OR_END(h, NULL);
     tclient a;
     SL_CHECK(tclient_connect(&a, h.port, NULL) == 0);
     SL_CHECK(tclient_hello(&a, NULL, NULL, W, H) == 0);

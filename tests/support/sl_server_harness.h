@@ -519,6 +519,17 @@ static __attribute__((unused)) double harness_healthz_number(int port, const cha
     return p ? atof(p + strlen(pat)) : -1;
 }
 
+/* In a test's main (sl_test.h): starts the harness h with extra arguments,
+ * or records the failure and ends the test. */
+#define HARNESS_START_OR_END(h, extra)          \
+    do {                                        \
+        if (harness_start(&(h), (extra)) != 0) { \
+            SL_CHECK(!"server started");        \
+            harness_stop(&(h));                 \
+            SL_TEST_END();                      \
+        }                                       \
+    } while (0)
+
 /* Gives the server started next a small ASan quarantine (8 MB), so its
  * resident memory reflects live data rather than freed buffers. Call before
  * harness_start; harmless without ASan. */
