@@ -29,34 +29,7 @@ import statistics
 import sys
 import time
 
-
-def fail(message):
-    print(json.dumps({"ok": False, "error": message}))
-    sys.stdout.flush()
-    sys.exit(1)
-
-
-def read_cameras(path):
-    frames = []
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            fields = line.split()
-            if not fields or fields[0].startswith("#"):
-                continue
-            if len(fields) != 12:
-                fail("%s:%d: want VIEW INDEX and 10 numbers" % (path, number))
-            frames.append((fields[0], int(fields[1]), [float(v) for v in fields[2:]]))
-    return frames
-
-
-def gl_renderer_of(window):
-    try:
-        for line in window.ReportCapabilities().splitlines():
-            if line.startswith("OpenGL renderer string:"):
-                return line.split(":", 1)[1].strip()
-    except Exception:  # only informative
-        pass
-    return "unknown"
+from vtk_peer_common import fail, gl_renderer_of, read_cameras
 
 
 def main():

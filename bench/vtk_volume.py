@@ -28,24 +28,7 @@ import statistics
 import sys
 import time
 
-
-def fail(message):
-    print(json.dumps({"ok": False, "error": message}))
-    sys.stdout.flush()
-    sys.exit(1)
-
-
-def read_cameras(path):
-    frames = []
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            fields = line.split()
-            if not fields or fields[0].startswith("#"):
-                continue
-            if len(fields) != 12:
-                fail("%s:%d: want VIEW INDEX and 10 numbers" % (path, number))
-            frames.append((fields[0], int(fields[1]), [float(v) for v in fields[2:]]))
-    return frames
+from vtk_peer_common import fail, gl_renderer_of, read_cameras
 
 
 def main():
@@ -146,13 +129,7 @@ def main():
                 png.SetInputConnection(grab.GetOutputPort())
                 png.Write()
                 written.add(view)
-    renderer = "unknown"
-    try:
-        for line in win.ReportCapabilities().splitlines():
-            if line.startswith("OpenGL renderer string:"):
-                renderer = line.split(":", 1)[1].strip()
-    except Exception:
-        pass
+    renderer = gl_renderer_of(win)
     out = {"ok": True, "first_frame_ms": first_ms, "gl_renderer": renderer, "views": {}}
     for view, v in times.items():
         out["views"][view] = {"median_ms": statistics.median(v), "min_ms": min(v), "max_ms": max(v), "frames": len(v)}
