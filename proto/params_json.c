@@ -47,14 +47,14 @@ static sl_status apply_enum_number(sl_params *p, const sl_param_def *d, double v
 }
 
 /* A transfer function from JSON: [[value, r, g, b, a], ...] (data units) or
- * {"colormap": name, "opacity": [[t, alpha], ...], "range": [lo, hi]}
+ * {"colormap": name, "opacity": [[t, alpha], ...] | "auto", "range": [lo, hi]}
  * ("opacity" defaults to [[0, 0], [1, 1]], "range" to the dataset's value
- * range). Shape errors name the point; value errors come from
+ * range; "auto": the ramp the volume technique picks from the histogram). Shape errors name the point; value errors come from
  * sl_params_set_transfer. */
 static sl_status apply_transfer(sl_params *p, const char *name, const cJSON *item, sl_err *err)
 {
-    static const char usage[] = "[[value, r, g, b, a], ...] or {\"colormap\": name, \"opacity\": [[t, alpha], ...], "
-                                "\"range\": [low, high]}";
+    static const char usage[] = "[[value, r, g, b, a], ...] or {\"colormap\": name, \"opacity\": [[t, alpha], ...] "
+                                "or \"auto\", \"range\": [low, high]}";
     sl_transfer_function tf;
     memset(&tf, 0, sizeof tf);
     const cJSON *points = item;
@@ -88,6 +88,13 @@ static sl_status apply_transfer(sl_params *p, const char *name, const cJSON *ite
             tf.range[1] = cJSON_GetArrayItem(range, 1)->valuedouble;
         }
         points = cJSON_GetObjectItemCaseSensitive(item, "opacity");
+        if (cJSON_IsString(points)) {
+            if (strcmp(points->valuestring, "auto") != 0)
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': \"opacity\" must be \"auto\" or "
+                                  "[[t, alpha], ...] (got \"%.40s\")", name, points->valuestring);
+            tf.auto_opacity = 1;
+            return sl_params_set_transfer(p, name, &tf, err);
+        }
         if (!points) {
             tf.count = 2;
             tf.point[1][0] = tf.point[1][1] = 1.0;
@@ -193,9 +200,13 @@ static cJSON *transfer_json(const sl_transfer_function *tf)
     }
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "colormap", sl_colormap_names[tf->colormap]);
-    cJSON *a = cJSON_AddArrayToObject(o, "opacity");
-    for (int k = 0; a && k < tf->count; k++)
-        cJSON_AddItemToArray(a, cJSON_CreateDoubleArray(tf->point[k], 2));
+    if (tf->auto_opacity) {
+        cJSON_AddStringToObject(o, "opacity", "auto");
+    } else {
+        cJSON *a = cJSON_AddArrayToObject(o, "opacity");
+        for (int k = 0; a && k < tf->count; k++)
+            cJSON_AddItemToArray(a, cJSON_CreateDoubleArray(tf->point[k], 2));
+    }
     if (tf->has_range)
         cJSON_AddItemToObject(o, "range", cJSON_CreateDoubleArray(tf->range, 2));
     return o;

@@ -27,6 +27,7 @@
 #include "data/sl_generate.h"
 #include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
+#include "volume/sl_volume.h"
 
 static const char *schema_sql =
     "CREATE TABLE IF NOT EXISTS datasets("
@@ -138,6 +139,14 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
         double range[2] = {ds->volume.value_min, ds->volume.value_max};
         if (isfinite(range[0]) && isfinite(range[1]))
             cJSON_AddItemToObject(c, "value_range", cJSON_CreateDoubleArray(range, 2));
+        double bins[SL_VOLUME_HISTOGRAM_BINS], ramp[4][2];
+        for (int k = 0; k < SL_VOLUME_HISTOGRAM_BINS; k++)
+            bins[k] = (double)ds->volume.histogram[k];
+        cJSON_AddItemToObject(c, "histogram", cJSON_CreateDoubleArray(bins, SL_VOLUME_HISTOGRAM_BINS));
+        int n = sl_volume_tf_auto_opacity(&ds->volume, ramp);
+        cJSON *a_ramp = cJSON_AddArrayToObject(c, "auto_opacity");
+        for (int k = 0; a_ramp && k < n; k++)
+            cJSON_AddItemToArray(a_ramp, cJSON_CreateDoubleArray(ramp[k], 2));
     }
     *bounds = cJSON_PrintUnformatted(b);
     *counts = cJSON_PrintUnformatted(c);

@@ -113,8 +113,9 @@ function attributeNames() {
 
 // What the controls may know of the dataset beyond its attributes.
 function datasetContext() {
-  const r = datasetByName(app.state?.dataset)?.counts?.value_range;
-  return { valueRange: Array.isArray(r) ? r : null };
+  const c = datasetByName(app.state?.dataset)?.counts || {};
+  const list = (x) => (Array.isArray(x) ? x : null);
+  return { valueRange: list(c.value_range), histogram: list(c.histogram), autoOpacity: list(c.auto_opacity) };
 }
 
 function buildParams() {
@@ -157,8 +158,12 @@ function applyState(patch) {
   if (techniqueChanged || datasetChanged || !params.inputs.size) buildParams();
   else params.update(app.state.params);
   // A dataset just loaded (new bounds) that the catalog had not described
-  // yet: ask again, so its attribute names reach the controls.
-  if ('bounds' in patch && !Array.isArray(datasetByName(app.state.dataset)?.attributes)) conn.send({ type: 'list_datasets' });
+  // yet (or described before it kept histograms): ask again, so its attribute
+  // names and histogram reach the controls.
+  const listed = datasetByName(app.state.dataset);
+  if ('bounds' in patch && (!Array.isArray(listed?.attributes) || (listed?.kind === 'volume' && !listed?.counts?.histogram))) {
+    conn.send({ type: 'list_datasets' });
+  }
   if (techniqueChanged || datasetChanged) fillPickers();
   // The controller's own camera is authoritative locally; it adopts only
   // cameras it did not send (scene, load_view) and new bounds.

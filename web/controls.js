@@ -89,10 +89,12 @@ export class ParamControls {
   // attributes: the dataset's per-vertex attribute names in index order
   // (null while the catalog does not know them yet), the options of every
   // parameter of type 'attribute'.
-  // context: what the controls may know of the dataset, { valueRange: [lo, hi] | null }
-  // (a volume's value range, for transfer-function editors).
+  // context: what the controls may know of the dataset, { valueRange: [lo, hi] | null,
+  // histogram, autoOpacity } (a volume's value range, histogram and automatic
+  // opacity ramp, for transfer-function editors).
   build(schema, attributes = null, context = {}) {
-    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes, context.valueRange || null]);
+    const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes, context.valueRange || null,
+      context.histogram || null, context.autoOpacity || null]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     this.form.replaceChildren();

@@ -8,8 +8,12 @@
 // then no value range is needed — and the points form ([[value, r, g, b, a],
 // ...] in data units) once a point gets a colour of its own, which needs the
 // dataset's value range (`context.valueRange`, from the catalog) or a range
-// in the value. Changes are sent throttled (every 100 ms while dragging, the
-// last one always). No histogram: the server does not send one yet.
+// in the value. Behind the curve: the dataset's 256-bin value histogram
+// (`context.histogram`, over the value range), log scale. The colormap
+// form's "opacity": "auto" shows the ramp the server picked from that
+// histogram (`context.autoOpacity`) and becomes an explicit ramp when a point
+// moves. Changes are sent throttled (every 100 ms while dragging, the last
+// one always).
 
 import { throttle } from './throttle.js';
 
@@ -33,11 +37,15 @@ function fmt(v) {
 
 export class TransferFunctionEditor {
   // row: the element to fill; def: the parameter's schema entry; onChange(value);
-  // context: { valueRange: [lo, hi] | null } of the session's dataset.
+  // context: { valueRange: [lo, hi] | null, histogram: [256 counts] | null,
+  // autoOpacity: [[t, alpha], ...] | null } of the session's dataset.
   constructor(row, def, onChange, context = {}) {
     this.def = def;
     this.colormaps = new Map((def.colormaps || []).map((m) => [m.name, m.colors]));
     this.valueRange = Array.isArray(context.valueRange) ? context.valueRange : null;
+    this.histogram = Array.isArray(context.histogram) && context.histogram.length ? context.histogram : null;
+    this.autoOpacity = Array.isArray(context.autoOpacity) && context.autoOpacity.length ? context.autoOpacity
+      : [[0, 0], [1, 0.2]];
     this.points = [];      // { t in 0..1 over the range, rgb: [r, g, b] | null (from the colormap), a }
     this.colormap = null;  // colormap form: its name
     this.range = null;     // [lo, hi] in data units, or null (the dataset's, not known here)
@@ -117,11 +125,20 @@ export class TransferFunctionEditor {
     } else if (v && typeof v === 'object') {
       this.colormap = v.colormap;
       this.range = Array.isArray(v.range) ? v.range : null;
-      this.points = (v.opacity || [[0, 0], [1, 1]]).map((p) => ({ t: p[0], rgb: null, a: p[1] }));
+      this.points = this.ramp(v.opacity).map((p) => ({ t: p[0], rgb: null, a: p[1] }));
     }
     this.preset.value = this.colormap || '';
     if (this.selected >= this.points.length) this.selected = -1;
     this.draw();
+  }
+
+  // A colormap form's opacity ramp; "auto" is the server's ramp over the
+  // dataset's value range, re-mapped onto the value's own range if it has one.
+  ramp(opacity) {
+    if (opacity !== 'auto') return opacity || [[0, 0], [1, 1]];
+    const vr = this.valueRange, r = this.range;
+    if (!r || !vr || !(r[1] > r[0])) return this.autoOpacity;
+    return this.autoOpacity.map(([t, a]) => [clamp((vr[0] + t * (vr[1] - vr[0]) - r[0]) / (r[1] - r[0]), 0, 1), a]);
   }
 
   // The value to send, in the form the editor holds.
@@ -236,6 +253,7 @@ export class TransferFunctionEditor {
   draw() {
     const g = this.canvas.getContext('2d');
     g.clearRect(0, 0, W, H);
+    this.drawHistogram(g);
     for (let x = 0; x < W; x++) {   // colour ramp along the bottom, the curve's area above it tinted
       const c = this.colourAt((x + 0.5) / W).map((k) => Math.round(k * 255));
       g.fillStyle = `rgb(${c.join(',')})`;
@@ -263,5 +281,23 @@ export class TransferFunctionEditor {
     const sel = pts[this.selected];
     const at = sel ? ` · point ${this.selected}: ${s ? fmt(s[0] + sel.t * (s[1] - s[0])) : `t ${fmt(sel.t)}`}, α ${fmt(sel.a)}` : '';
     this.info.textContent = `${s ? `${fmt(s[0])} … ${fmt(s[1])} ${this.def.unit || ''}` : 'the dataset\'s value range'}${at}`;
+  }
+
+  // The histogram's bins (over the dataset's value range) as grey bars of
+  // height log(1 + count) / log(1 + largest count), placed over the span.
+  drawHistogram(g) {
+    const h = this.histogram, vr = this.valueRange, s = this.span();
+    if (!h || !vr || !s || !(s[1] > s[0])) return;
+    const top = Math.log1p(Math.max(...h));
+    if (!(top > 0)) return;
+    const x = (v) => ((v - s[0]) / (s[1] - s[0])) * W;
+    const bin = (vr[1] - vr[0]) / h.length;
+    g.fillStyle = 'rgba(160, 165, 180, 0.35)';
+    h.forEach((c, k) => {
+      if (!c) return;
+      const x0 = x(vr[0] + k * bin), x1 = bin > 0 ? x(vr[0] + (k + 1) * bin) : x0 + W / h.length;
+      const y = (Math.log1p(c) / top) * (H - 8);
+      g.fillRect(x0, H - 8 - y, Math.max(1, x1 - x0), y);
+    });
   }
 }

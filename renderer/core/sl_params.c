@@ -31,6 +31,10 @@ void sl_transfer_function_default(const sl_param_def *d, sl_transfer_function *o
 {
     memset(out, 0, sizeof *out);
     out->colormap = (int)d->def[0];
+    if (d->def[1] == SL_TF_AUTO_OPACITY) {
+        out->auto_opacity = 1;
+        return;
+    }
     out->count = 2;
     out->point[0][0] = 0.0;
     out->point[0][1] = d->def[1];
@@ -51,7 +55,11 @@ sl_status sl_transfer_function_check(const char *name, const sl_transfer_functio
     if (tf->colormap >= colormap_count())
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': no colormap %d (0 .. %d)", name, tf->colormap,
                           colormap_count() - 1);
-    if (tf->count < 1 || tf->count > SL_TF_MAX_POINTS)
+    if (tf->auto_opacity) {
+        if (tf->colormap < 0 || tf->count != 0)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': an automatic opacity needs the colormap form "
+                              "and no opacity points", name);
+    } else if (tf->count < 1 || tf->count > SL_TF_MAX_POINTS)
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes 1 to %d points, got %d", name,
                           SL_TF_MAX_POINTS, tf->count);
     int colormap_form = tf->colormap >= 0;
@@ -97,6 +105,7 @@ sl_status sl_params_set_transfer(sl_params *p, const char *name, const sl_transf
     sl_transfer_function clean;
     memset(&clean, 0, sizeof clean);
     clean.colormap = tf->colormap < 0 ? -1 : tf->colormap;
+    clean.auto_opacity = tf->auto_opacity != 0;
     clean.count = tf->count;
     clean.has_range = clean.colormap >= 0 && tf->has_range;
     if (clean.has_range)
@@ -293,10 +302,11 @@ const sl_transfer_function *sl_params_transfer(const sl_params *p, const char *n
     return i < 0 ? &p->tf[0] : &p->tf[(int)p->value[i][0]];
 }
 
-/* Equal transfer functions: field by field (no padding compared). */
-static int same_transfer(const sl_transfer_function *a, const sl_transfer_function *b)
+/* Field by field (no padding compared). */
+int sl_transfer_function_equal(const sl_transfer_function *a, const sl_transfer_function *b)
 {
-    return a->colormap == b->colormap && a->count == b->count && a->has_range == b->has_range &&
+    return a->colormap == b->colormap && a->auto_opacity == b->auto_opacity && a->count == b->count &&
+           a->has_range == b->has_range &&
            memcmp(a->range, b->range, sizeof a->range) == 0 && memcmp(a->point, b->point, sizeof a->point) == 0;
 }
 
@@ -308,7 +318,7 @@ sl_invalidation sl_params_compare(const sl_params *a, const sl_params *b)
     for (int i = 0; i < a->count; i++) {
         int differs = memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0;
         if (!differs && a->schema[i].type == SL_PARAM_TRANSFER)
-            differs = !same_transfer(&a->tf[(int)a->value[i][0]], &b->tf[(int)b->value[i][0]]);
+            differs = !sl_transfer_function_equal(&a->tf[(int)a->value[i][0]], &b->tf[(int)b->value[i][0]]);
         if (differs && a->schema[i].invalidates > level)
             level = a->schema[i].invalidates;
     }

@@ -29,7 +29,9 @@ typedef enum sl_param_type {
     SL_PARAM_TRANSFER,  /* a transfer function (sl_transfer_function below); min/max
                            unused; default: def[0] = colormap index, opacity ramp
                            from def[1] at t = 0 to def[2] at t = 1 over the
-                           dataset's value range. Set with sl_params_set_transfer. */
+                           dataset's value range, or, with def[1] =
+                           SL_TF_AUTO_OPACITY, the dataset's automatic ramp
+                           (auto_opacity). Set with sl_params_set_transfer. */
 } sl_param_type;
 
 /* A transfer function as given, in one of two forms (renderer/volume/
@@ -40,13 +42,18 @@ typedef enum sl_param_type {
  *   colormap: colormap >= 0 (index into sl_colormap_names); point[k] =
  *             {t, alpha} (t in [0, 1], non-decreasing) an opacity ramp;
  *             t = 0 and 1 are range[0] and range[1] in data units when
- *             has_range, else the dataset's value range.
+ *             has_range, else the dataset's value range. With
+ *             auto_opacity the ramp is not given (count 0): the volume
+ *             techniques pick one per dataset from its histogram
+ *             (sl_volume_tf_auto_opacity in renderer/volume/).
  * Unused entries are zero, so two equal functions compare equal bytewise. */
 #define SL_TF_MAX_POINTS 64
 #define SL_PARAMS_MAX_TF 2 /* transfer-function parameters per schema */
+#define SL_TF_AUTO_OPACITY (-1.0) /* sl_param_def.def[1] of a default with auto_opacity */
 typedef struct sl_transfer_function {
     int colormap;
-    int count;                      /* 1 .. SL_TF_MAX_POINTS */
+    int auto_opacity;               /* colormap form only: the ramp comes from the data */
+    int count;                      /* 1 .. SL_TF_MAX_POINTS; 0 with auto_opacity */
     int has_range;
     double range[2];                /* colormap form with has_range: range[0] < range[1] */
     double point[SL_TF_MAX_POINTS][5];
@@ -99,6 +106,8 @@ sl_status sl_params_set_transfer(sl_params *p, const char *name, const sl_transf
 void sl_transfer_function_default(const sl_param_def *d, sl_transfer_function *out);
 /* Validates tf alone; err names `name` and the bad point. */
 sl_status sl_transfer_function_check(const char *name, const sl_transfer_function *tf, sl_err *err);
+/* 1 when a and b are the same function as given (field by field). */
+int sl_transfer_function_equal(const sl_transfer_function *a, const sl_transfer_function *b);
 
 /* Getters for techniques; the name must exist in the schema with that type
  * (a programmer error otherwise: asserts, then returns 0). */

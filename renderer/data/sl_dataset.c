@@ -267,6 +267,40 @@ static void vector_magnitude_range(const float *f, size_t n, double *lo, double 
     *hi = h;
 }
 
+/* The histogram of the finite values over [lo, hi] (see sl_volume). */
+#define HISTOGRAM_LOOP(T, VALUE, STRIDE)                                  \
+    do {                                                                  \
+        const T *p = v->data;                                             \
+        for (size_t i = 0; i < n; i++, p += (STRIDE)) {                   \
+            double s = (VALUE);                                           \
+            if (!isfinite(s))                                             \
+                continue;                                                 \
+            double b = (s - lo) * scale;                                  \
+            v->histogram[b < last ? (size_t)b : (size_t)last]++;          \
+            v->finite_count++;                                            \
+        }                                                                 \
+    } while (0)
+
+static void volume_histogram(sl_volume *v, size_t n)
+{
+    double lo = v->value_min, hi = v->value_max;
+    double scale = hi > lo ? SL_VOLUME_HISTOGRAM_BINS / (hi - lo) : 0.0;
+    double last = SL_VOLUME_HISTOGRAM_BINS - 1;
+    memset(v->histogram, 0, sizeof v->histogram);
+    v->finite_count = 0;
+    if (v->components == 3) {
+        HISTOGRAM_LOOP(float, sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]), 3);
+        return;
+    }
+    switch (v->type) {
+    case SL_VOXEL_U8: HISTOGRAM_LOOP(uint8_t, (double)*p, 1); break;
+    case SL_VOXEL_U16: HISTOGRAM_LOOP(uint16_t, (double)*p, 1); break;
+    case SL_VOXEL_S16: HISTOGRAM_LOOP(int16_t, (double)*p, 1); break;
+    case SL_VOXEL_F32: HISTOGRAM_LOOP(float, (double)*p, 1); break;
+    }
+}
+#undef HISTOGRAM_LOOP
+
 sl_status sl_dataset_finish_volume(sl_dataset *ds, sl_err *err)
 {
     sl_volume *v = &ds->volume;
@@ -283,6 +317,7 @@ sl_status sl_dataset_finish_volume(sl_dataset *ds, sl_err *err)
         scalar_range(v->type, v->data, n, &lo, &hi);
     v->value_min = lo <= hi ? lo : 0.0;
     v->value_max = lo <= hi ? hi : 0.0;
+    volume_histogram(v, n);
     ds->bounds_min = ds->origin;
     ds->bounds_max = sl_v3(ds->origin.x + (v->dims[0] - 1) * v->spacing[0],
                            ds->origin.y + (v->dims[1] - 1) * v->spacing[1],

@@ -57,6 +57,9 @@ typedef enum sl_voxel_type {
     SL_VOXEL_U8, SL_VOXEL_U16, SL_VOXEL_S16, SL_VOXEL_F32
 } sl_voxel_type;
 
+/* Bins of a volume's value histogram (sl_volume.histogram). */
+#define SL_VOLUME_HISTOGRAM_BINS 256
+
 typedef struct sl_volume {
     int dims[3];             /* voxels along x, y, z; x fastest in memory */
     int components;          /* 1 for scalar volumes, 3 for vector fields (always f32) */
@@ -64,6 +67,11 @@ typedef struct sl_volume {
     void *data;              /* dims[0]*dims[1]*dims[2]*components values, native byte order */
     double spacing[3];       /* world units between voxel centres, > 0 */
     double value_min, value_max; /* over all finite values (vector fields: of the magnitude) */
+    /* Counts of the finite values (magnitudes) over [value_min, value_max]:
+     * bin k = floor((v - min) / (max - min) * BINS), value_max in the last
+     * bin; a constant volume has every value in bin 0. Filled with the range. */
+    uint64_t histogram[SL_VOLUME_HISTOGRAM_BINS];
+    uint64_t finite_count;       /* the sum of histogram */
 } sl_volume;
 
 typedef struct sl_dataset {
@@ -115,7 +123,7 @@ sl_status sl_dataset_finish_lines(sl_dataset *ds, sl_err *err);
 sl_status sl_volume_alloc(sl_volume *vol, const int dims[3], int components,
                           sl_voxel_type type, sl_err *err);
 
-/* Computes value_min/max and ds->bounds from origin, dims and spacing. */
+/* Computes value_min/max, the histogram and ds->bounds from origin, dims and spacing. */
 sl_status sl_dataset_finish_volume(sl_dataset *ds, sl_err *err);
 
 /* Voxel value as double (component c) at integer coordinates; no bounds check. */

@@ -4,7 +4,8 @@
  * volume's geometry (values at voxel centres, the box spanning them), its 3D
  * texture (every voxel type, exact data values), the transfer function
  * resolved for a dataset and baked into a small 1D texture, and the min-max
- * brick grid with a per-transfer-function "visible bricks" mask. GLSL halves:
+ * brick grid with a per-transfer-function "visible bricks" mask and its
+ * runs (distance maps: how far a ray may go without a brick lookup). GLSL halves:
  * volume/volume_ray.glsl (ray–box + clip box), volume/volume_sample.glsl
  * (values), volume/volume_tf.glsl (lookup + opacity correction).
  * Invariants: the min-max grid is built once per volume; a new transfer
@@ -65,8 +66,9 @@ sl_status sl_volume_gradient_create(const sl_volume *vol, GLuint *tex, size_t *b
 /* A transfer function resolved for a dataset: control points in data units,
  * piecewise linear, constant beyond the ends. The colormap form becomes the
  * union of the colormap's own control points and the opacity ramp's (exact:
- * both are piecewise linear in t). A range of one value (constant volume)
- * is widened to [v - 0.5, v + 0.5]. */
+ * both are piecewise linear in t), over tf's range or vol's value range; a
+ * range of one value (constant volume) is widened to [v - 0.5, v + 0.5].
+ * auto_opacity takes the ramp of sl_volume_tf_auto_opacity(vol). */
 #define SL_VOLUME_TF_MAX (SL_TF_MAX_POINTS + 16)
 typedef struct sl_volume_tf_points {
     int count;
@@ -74,8 +76,22 @@ typedef struct sl_volume_tf_points {
     double rgba[SL_VOLUME_TF_MAX][4];
 } sl_volume_tf_points;
 
-void sl_volume_tf_resolve(const sl_transfer_function *tf, double value_min, double value_max,
-                          sl_volume_tf_points *out);
+void sl_volume_tf_resolve(const sl_transfer_function *tf, const sl_volume *vol, sl_volume_tf_points *out);
+
+/* The opacity ramp of the colormap form's "opacity": "auto", from the
+ * volume's histogram: [t, alpha] points over its value range (t in 0..1,
+ * at most 4). When the histogram has a background peak in its lower half
+ * (one bin holding >= SL_VOLUME_AUTO_PEAK of the values: air around a CT,
+ * the zeros around an MRI), the ramp starts at 0 where that peak falls to
+ * its first minimum (smoothed over 5 bins); it rises to SL_VOLUME_AUTO_ALPHA
+ * at the 99.5th percentile of the values above, and stays there; convex
+ * (SL_VOLUME_AUTO_MID of it half-way), so low values (skin, soft tissue)
+ * stay translucent and the high ones (bone, white matter) show through. Without such a peak: 0 at t = 0 to the same alpha at the
+ * 99.5th percentile. A volume without finite values: [[0, 0], [1, alpha]]. */
+#define SL_VOLUME_AUTO_PEAK 0.05
+#define SL_VOLUME_AUTO_ALPHA 0.2
+#define SL_VOLUME_AUTO_MID 0.125 /* alpha at the ramp's middle, as a share of AUTO_ALPHA */
+int sl_volume_tf_auto_opacity(const sl_volume *vol, double ramp[4][2]);
 /* rgba at value v (NaN: transparent black). */
 void sl_volume_tf_eval(const sl_volume_tf_points *pts, double v, double rgba[4]);
 
@@ -108,8 +124,9 @@ typedef struct sl_volume_bricks {
     int dims[3];              /* bricks per axis */
     float *minmax;            /* 2 per brick, x fastest; owned */
     uint8_t *mask;            /* 1 per brick: 1 = visible; owned */
+    uint8_t *runs;            /* 1 per brick: sl_volume_brick_runs of mask; owned */
     GLuint minmax_tex;        /* RG32F */
-    GLuint mask_tex;          /* R8UI */
+    GLuint runs_tex;          /* R8UI: runs */
     size_t bytes;             /* GPU bytes */
 } sl_volume_bricks;
 
@@ -123,10 +140,25 @@ typedef enum sl_volume_mask_rule {
     SL_VOLUME_MASK_ISO,       /* visible where min <= iso <= max */
     SL_VOLUME_MASK_FINITE,    /* visible where the brick has a finite value */
 } sl_volume_mask_rule;
-/* Rebuilds the mask from the min-max grid (never rebuilds the grid) and
- * uploads it; returns the number of visible bricks. */
+/* Rebuilds the mask and its runs from the min-max grid (never rebuilds the
+ * grid) and uploads the runs; returns the number of visible bricks. When
+ * the runs' scratch cannot be allocated every brick is a run of its own
+ * (d = 1: one lookup per brick, still exact). */
 size_t sl_volume_bricks_update_mask(sl_volume_bricks *b, sl_volume_mask_rule rule, const sl_volume_tf_table *table,
                                     double iso);
+
+/* Runs of a brick mask (visible: 1 byte per brick, nonzero = visible), for
+ * rays to cross without a lookup per brick. An invisible brick gets d in
+ * 1..SL_VOLUME_RUN_MAX: its Chebyshev distance in bricks to the nearest
+ * visible one (capped, also when none is visible); a visible brick gets
+ * SL_VOLUME_RUN_VISIBLE + d, d its distance to the nearest invisible one.
+ * Either way every brick within d - 1 of it (the cube of 2d - 1 bricks per
+ * side around it) is of its kind: a ray may skip, or sample without looking
+ * bricks up, until it leaves that cube. Returns 0, or -1 when out of memory
+ * (out unchanged). */
+#define SL_VOLUME_RUN_MAX 127
+#define SL_VOLUME_RUN_VISIBLE 128
+int sl_volume_brick_runs(const uint8_t *visible, const int dims[3], uint8_t *out);
 
 /* Work counters: process-wide totals, never reset (compare two readings).
  * Render thread only, unlocked. */

@@ -1,10 +1,10 @@
-/* volume_bricks.c — the min-max brick grid and its visible-brick mask (see sl_volume.h); the counters.
+/* volume_bricks.c — the min-max brick grid, its visible-brick mask and runs (see sl_volume.h); the counters.
  *
  * The grid is one CPU pass over the voxels at create (brick b spans voxels
  * [8b, 8b + 8]: the overlap voxel makes every trilinear sample in the brick
  * depend on that brick's voxels only), kept in memory so that a new
- * transfer function only re-derives the 1-byte-per-brick mask from it and
- * uploads that. NaN voxels are left out of min/max (a brick of NaN only has
+ * transfer function only re-derives the 1-byte-per-brick mask from it, its
+ * runs (volume_brick_runs.c), and uploads those. NaN voxels are left out of min/max (a brick of NaN only has
  * min > max and is never visible). Render thread only (GL, counters).
  */
 #include "sl_volume.h"
@@ -28,10 +28,11 @@ void sl_volume_bricks_destroy(sl_volume_bricks *b)
         return;
     if (b->minmax_tex)
         glDeleteTextures(1, &b->minmax_tex);
-    if (b->mask_tex)
-        glDeleteTextures(1, &b->mask_tex);
+    if (b->runs_tex)
+        glDeleteTextures(1, &b->runs_tex);
     free(b->minmax);
     free(b->mask);
+    free(b->runs);
     memset(b, 0, sizeof *b);
 }
 
@@ -60,7 +61,8 @@ sl_status sl_volume_bricks_create(const sl_volume *vol, sl_volume_bricks *b, sl_
     size_t n = (size_t)b->dims[0] * (size_t)b->dims[1] * (size_t)b->dims[2];
     b->minmax = malloc(n * 2 * sizeof *b->minmax);
     b->mask = malloc(n);
-    if (!b->minmax || !b->mask) {
+    b->runs = malloc(n);
+    if (!b->minmax || !b->mask || !b->runs) {
         sl_volume_bricks_destroy(b);
         return sl_err_set(err, SL_ERR_NOMEM, "volume: out of memory for %zu bricks", n);
     }
@@ -93,16 +95,17 @@ sl_status sl_volume_bricks_create(const sl_volume *vol, sl_volume_bricks *b, sl_
                         }
             }
     memset(b->mask, 1, n);
+    memset(b->runs, SL_VOLUME_RUN_VISIBLE + 1, n);
     glCreateTextures(GL_TEXTURE_3D, 1, &b->minmax_tex);
     glTextureStorage3D(b->minmax_tex, 1, GL_RG32F, b->dims[0], b->dims[1], b->dims[2]);
     glTextureSubImage3D(b->minmax_tex, 0, 0, 0, 0, b->dims[0], b->dims[1], b->dims[2], GL_RG, GL_FLOAT, b->minmax);
-    glCreateTextures(GL_TEXTURE_3D, 1, &b->mask_tex);
-    glTextureStorage3D(b->mask_tex, 1, GL_R8UI, b->dims[0], b->dims[1], b->dims[2]);
+    glCreateTextures(GL_TEXTURE_3D, 1, &b->runs_tex);
+    glTextureStorage3D(b->runs_tex, 1, GL_R8UI, b->dims[0], b->dims[1], b->dims[2]);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage3D(b->mask_tex, 0, 0, 0, 0, b->dims[0], b->dims[1], b->dims[2], GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-                        b->mask);
+    glTextureSubImage3D(b->runs_tex, 0, 0, 0, 0, b->dims[0], b->dims[1], b->dims[2], GL_RED_INTEGER,
+                        GL_UNSIGNED_BYTE, b->runs); /* all visible, runs of 1 */
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    GLuint texs[2] = {b->minmax_tex, b->mask_tex};
+    GLuint texs[2] = {b->minmax_tex, b->runs_tex};
     for (int k = 0; k < 2; k++) {
         glTextureParameteri(texs[k], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(texs[k], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -130,9 +133,12 @@ size_t sl_volume_bricks_update_mask(sl_volume_bricks *b, sl_volume_mask_rule rul
         b->mask[i] = (uint8_t)v;
         visible += (size_t)v;
     }
+    if (sl_volume_brick_runs(b->mask, b->dims, b->runs) != 0)
+        for (size_t i = 0; i < n; i++)
+            b->runs[i] = (uint8_t)(b->mask[i] ? SL_VOLUME_RUN_VISIBLE + 1 : 1);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage3D(b->mask_tex, 0, 0, 0, 0, b->dims[0], b->dims[1], b->dims[2], GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-                        b->mask);
+    glTextureSubImage3D(b->runs_tex, 0, 0, 0, 0, b->dims[0], b->dims[1], b->dims[2], GL_RED_INTEGER,
+                        GL_UNSIGNED_BYTE, b->runs);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     sl_volume_counters_now.mask_builds++;
     return visible;

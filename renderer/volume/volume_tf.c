@@ -37,10 +37,87 @@ static double ramp_alpha(const sl_transfer_function *tf, double t)
     return tf->point[tf->count - 1][1];
 }
 
-void sl_volume_tf_resolve(const sl_transfer_function *tf, double value_min, double value_max,
-                          sl_volume_tf_points *out)
+/* Smoothed bin k: the mean of bins k-2 .. k+2 that exist. */
+static double smoothed(const uint64_t *h, int k)
+{
+    double sum = 0.0;
+    int n = 0;
+    for (int j = k - 2; j <= k + 2; j++)
+        if (j >= 0 && j < SL_VOLUME_HISTOGRAM_BINS) {
+            sum += (double)h[j];
+            n++;
+        }
+    return sum / n;
+}
+
+int sl_volume_tf_auto_opacity(const sl_volume *vol, double ramp[4][2])
+{
+    const int bins = SL_VOLUME_HISTOGRAM_BINS;
+    const uint64_t *h = vol->histogram;
+    double total = (double)vol->finite_count;
+    if (!(total > 0.0)) {
+        ramp[0][0] = 0.0, ramp[0][1] = 0.0;
+        ramp[1][0] = 1.0, ramp[1][1] = SL_VOLUME_AUTO_ALPHA;
+        return 2;
+    }
+    int peak = 0;
+    for (int k = 1; k < bins; k++)
+        if (h[k] > h[peak])
+            peak = k;
+    /* start: the first bin of the ramp (0 without a background peak). */
+    int start = 0;
+    if (peak < bins / 2 && (double)h[peak] >= SL_VOLUME_AUTO_PEAK * total) {
+        /* Past the smoothing window of the spike first (zeros beside a
+         * one-bin spike make the smoothed curve rise for two bins). */
+        start = peak;
+        while (start < bins - 1 && (start < peak + 2 || smoothed(h, start + 1) < smoothed(h, start)))
+            start++;
+    }
+    /* end: the bin holding the 99.5th percentile of the values from start on. */
+    double above = 0.0;
+    for (int k = start; k < bins; k++)
+        above += (double)h[k];
+    int end = bins - 1;
+    double seen = 0.0;
+    for (int k = start; k < bins && above > 0.0; k++) {
+        seen += (double)h[k];
+        if (seen >= 0.995 * above) {
+            end = k;
+            break;
+        }
+    }
+    double t0 = (double)start / bins, t1 = (double)(end + 1) / bins;
+    if (t1 <= t0)
+        t1 = fmin(1.0, t0 + 1.0 / bins);
+    if (t1 <= t0) /* start is the last bin */
+        t0 = t1 - 1.0 / bins;
+    int n = 0;
+    ramp[n][0] = t0, ramp[n++][1] = 0.0;
+    ramp[n][0] = 0.5 * (t0 + t1), ramp[n++][1] = SL_VOLUME_AUTO_ALPHA * SL_VOLUME_AUTO_MID;
+    ramp[n][0] = t1, ramp[n++][1] = SL_VOLUME_AUTO_ALPHA;
+    return n;
+}
+
+void sl_volume_tf_resolve(const sl_transfer_function *given, const sl_volume *vol, sl_volume_tf_points *out)
 {
     memset(out, 0, sizeof *out);
+    double value_min = vol->value_min, value_max = vol->value_max;
+    sl_transfer_function with_ramp;
+    const sl_transfer_function *tf = given;
+    if (given->auto_opacity) {
+        double ramp[4][2] = {{0}};
+        with_ramp = *given;
+        with_ramp.count = sl_volume_tf_auto_opacity(vol, ramp);
+        /* The ramp's t spans the value range; a given range re-maps it. */
+        double span = value_max > value_min ? value_max - value_min : 1.0;
+        for (int k = 0; k < with_ramp.count; k++) {
+            double t = ramp[k][0];
+            if (given->has_range)
+                t = (value_min + t * span - given->range[0]) / (given->range[1] - given->range[0]);
+            with_ramp.point[k][0] = t, with_ramp.point[k][1] = ramp[k][1];
+        }
+        tf = &with_ramp;
+    }
     if (tf->colormap < 0) {
         out->count = tf->count;
         for (int k = 0; k < tf->count; k++) {

@@ -12,6 +12,7 @@
  * (checked against tests/support/volume_reference.h). Render thread only.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,9 +28,9 @@ static const char *const interpolation_names[] = {"linear", "nearest", NULL};
 static const char *const gradient_names[] = {"on_the_fly", "texture", NULL};
 
 static const sl_param_def volume_dvr_params[] = {
-    {"transfer_function", SL_PARAM_TRANSFER, 0, 0, {0, 0.0, 0.2}, NULL, "data",
+    {"transfer_function", SL_PARAM_TRANSFER, 0, 0, {0, SL_TF_AUTO_OPACITY, 0}, NULL, "data",
      "colour and opacity per data value: points [[value, r, g, b, a], ...] or {colormap, opacity ramp, range}; "
-     "default viridis with opacity 0 to 0.2 over the value range", SL_INVALIDATE_FRAME},
+     "default viridis over the value range with an opacity ramp chosen from the histogram", SL_INVALIDATE_FRAME},
     {"mode", SL_PARAM_ENUM, 0, 0, {0}, mode_names, "",
      "composite (emission-absorption), mip (maximum intensity), iso (first crossing of isovalue, shaded)",
      SL_INVALIDATE_FRAME},
@@ -64,12 +65,21 @@ static const sl_param_def volume_dvr_params[] = {
 
 enum { MODE_COMPOSITE, MODE_MIP, MODE_ISO };
 
+/* Shader variants: mode x shading x gradient source (volume_dvr.frag.glsl's
+ * SL_MODE, SL_SHADING, SL_GRADIENT_TEX); mip never shades. */
+#define PROGRAM_VARIANTS 12
+static int variant_of(int mode, int shading, int gradient_tex)
+{
+    return mode + 3 * (shading != 0) + 6 * (shading && gradient_tex);
+}
+
 typedef struct volume_dvr_state {
     const sl_dataset *dataset;     /* borrowed */
     sl_volume_geometry geom;
     sl_volume_texture volume;
     sl_volume_bricks bricks;
-    GLuint program, vao, camera_ubo, tf_tex, rows_buf;
+    GLuint programs[PROGRAM_VARIANTS]; /* by variant_of(); compiled on first use, 0 until then */
+    GLuint vao, camera_ubo, tf_tex, rows_buf;
     GLuint gradient_tex;           /* built at the first frame that shades with it, or 0 */
     int rows_capacity;             /* pixel rows rows_buf holds */
     sl_volume_tf_table *table;     /* owned; the baked loaded TF */
@@ -89,7 +99,9 @@ static void volume_dvr_release(void *opaque)
         return;
     sl_volume_texture_destroy(&s->volume);
     sl_volume_bricks_destroy(&s->bricks);
-    if (s->program) glDeleteProgram(s->program);
+    for (int i = 0; i < PROGRAM_VARIANTS; i++)
+        if (s->programs[i])
+            glDeleteProgram(s->programs[i]);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     if (s->tf_tex) glDeleteTextures(1, &s->tf_tex);
@@ -97,6 +109,27 @@ static void volume_dvr_release(void *opaque)
     if (s->gradient_tex) glDeleteTextures(1, &s->gradient_tex);
     free(s->table);
     free(s);
+}
+
+/* The program of a variant, compiled the first time it is asked for
+ * (about 0.1-0.3 s on llvmpipe; the composite one at prepare). */
+static sl_status program_for(volume_dvr_state *s, int variant, GLuint *out, sl_err *err)
+{
+    if (!s->programs[variant]) {
+        int mode = variant % 3, shading = variant >= 3, gradient_tex = variant >= 6;
+        char defines[128], label[48];
+        snprintf(defines, sizeof defines, "#define SL_MODE %d\n#define SL_SHADING %d\n#define SL_GRADIENT_TEX %d\n",
+                 mode, shading, gradient_tex);
+        snprintf(label, sizeof label, "volume_dvr (variant %d)", variant);
+        sl_status st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
+                                                               .fragment = "volume_dvr/volume_dvr.frag.glsl",
+                                                               .defines = defines, .label = label},
+                                            &s->programs[variant], err);
+        if (st != SL_OK)
+            return st;
+    }
+    *out = s->programs[variant];
+    return SL_OK;
 }
 
 static sl_status volume_dvr_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
@@ -113,9 +146,8 @@ static sl_status volume_dvr_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     s->dataset = ds;
     s->mask_rule = -1;
     sl_volume_geometry_init(ds, &s->geom);
-    sl_status st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
-                                                           .fragment = "volume_dvr/volume_dvr.frag.glsl",
-                                                           .label = "volume_dvr"}, &s->program, err);
+    GLuint program = 0;
+    sl_status st = program_for(s, variant_of(MODE_COMPOSITE, 0, 0), &program, err);
     if (st != SL_OK)
         goto fail;
     double t_upload = sl_clock_ms();
@@ -141,21 +173,15 @@ fail:
     return st;
 }
 
-static int same_tf(const sl_transfer_function *a, const sl_transfer_function *b)
-{
-    return a->colormap == b->colormap && a->count == b->count && a->has_range == b->has_range &&
-           memcmp(a->range, b->range, sizeof a->range) == 0 && memcmp(a->point, b->point, sizeof a->point) == 0;
-}
-
 /* Re-bakes the TF when it changed and rebuilds the brick mask when its
  * rule (mode), the TF (composite) or the isovalue (iso) changed. */
 static void update_tf_and_mask(volume_dvr_state *s, const sl_params *params, int mode, double iso)
 {
     const sl_transfer_function *tf = sl_params_transfer(params, "transfer_function");
-    int tf_changed = !s->tf_valid || !same_tf(tf, &s->tf_loaded);
+    int tf_changed = !s->tf_valid || !sl_transfer_function_equal(tf, &s->tf_loaded);
     if (tf_changed) {
         sl_volume_tf_points pts;
-        sl_volume_tf_resolve(tf, s->dataset->volume.value_min, s->dataset->volume.value_max, &pts);
+        sl_volume_tf_resolve(tf, &s->dataset->volume, &pts);
         sl_volume_tf_bake(&pts, s->table);
         sl_volume_tf_texture_upload(s->tf_tex, s->table);
         s->tf_loaded = *tf;
@@ -187,7 +213,7 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
     int mode = sl_params_choice(params, "mode");
     double iso = sl_params_float(params, "isovalue");
     update_tf_and_mask(s, params, mode, iso);
-    int shading = sl_params_bool(params, "shading") || mode == MODE_ISO;
+    int shading = (sl_params_bool(params, "shading") && mode == MODE_COMPOSITE) || mode == MODE_ISO;
     int gradient_tex = shading && sl_params_choice(params, "gradient") == 1;
     if (gradient_tex && !s->gradient_tex) {
         size_t bytes = 0;
@@ -222,7 +248,11 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
         lo[a] = g->box_lo[a] + clip_min[a] * span;
         hi[a] = g->box_lo[a] + clip_max[a] * span;
     }
+    /* Interactive frames (a camera drag) sample half as densely; the
+     * opacity correction keeps their look, only finer detail is lost. */
     double step = sl_params_float(params, "step");
+    if (view->quality == SL_QUALITY_INTERACTIVE)
+        step = fmin(2.0 * step, 16.0);
     const double bg[3] = {view->background[0], view->background[1], view->background[2]};
     /* Light: eye space (x right, y up, z towards the viewer) to world. */
     float l[3];
@@ -237,7 +267,10 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
     const double light[3] = {lw.x, lw.y, lw.z};
 
     sl_camera_ubo_update(&s->camera_ubo, view);
-    GLuint p = s->program;
+    GLuint p = 0;
+    sl_status pst = program_for(s, variant_of(mode, shading, gradient_tex), &p, err);
+    if (pst != SL_OK)
+        return pst;
     glUseProgram(p);
     set3f(p, "u_eye_v", eye_v);
     set3f(p, "u_inv_spacing", inv_spacing);
@@ -246,11 +279,9 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
     set1f(p, "u_dt", step * g->min_spacing);
     set1f(p, "u_step", step);
     set1f(p, "u_min_spacing", g->min_spacing);
-    set1i(p, "u_mode", mode);
     set1f(p, "u_iso", iso);
     set1f(p, "u_alpha_stop", sl_params_float(params, "alpha_threshold"));
     set1i(p, "u_jitter", sl_params_bool(params, "jitter"));
-    set1i(p, "u_shading", sl_params_bool(params, "shading"));
     set1i(p, "u_skipping", sl_params_bool(params, "empty_space_skipping"));
     glUniform3i(glGetUniformLocation(p, "u_brick_dims"), s->bricks.dims[0], s->bricks.dims[1], s->bricks.dims[2]);
     set3f(p, "u_background", bg);
@@ -265,13 +296,12 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
                 (float)((SL_VOLUME_TF_TEXELS - 1) / (s->table->hi - s->table->lo)));
     set1i(p, "u_volume", 0);
     set1i(p, "u_tf", 1);
-    set1i(p, "u_mask", 2);
+    set1i(p, "u_runs", 2);
     set1i(p, "u_minmax", 3);
     set1i(p, "u_gradient", 4);
-    set1i(p, "u_gradient_tex", gradient_tex);
     glBindTextureUnit(0, s->volume.tex);
     glBindTextureUnit(1, s->tf_tex);
-    glBindTextureUnit(2, s->bricks.mask_tex);
+    glBindTextureUnit(2, s->bricks.runs_tex);
     glBindTextureUnit(3, s->bricks.minmax_tex);
     glBindTextureUnit(4, gradient_tex ? s->gradient_tex : s->volume.tex);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, s->rows_buf);

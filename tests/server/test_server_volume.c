@@ -1,8 +1,9 @@
 /* test_server_volume.c — a volume through the protocol: `scene` with the built-in
  * marschner_lobb and technique volume_dvr renders it (the frame shows the volume and
  * matches sightline-render of the same scene up to JPEG), a `set` of a bad
- * transfer-function point is a bad_param error naming the point, and a valid new
- * transfer function changes the frame. Starts its own server (sl_server_harness.h).
+ * transfer-function point is a bad_param error naming the point, a valid new
+ * transfer function changes the frame, the catalog then lists the volume's
+ * histogram, and "opacity": "auto" draws it. Starts its own server (sl_server_harness.h).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -109,8 +110,53 @@ int main(void)
     printf("new transfer function: mean |diff| %.3f\n", d2);
     SL_CHECK_MSG(d2 > 2.0, "a new transfer function changed the frame by only %.3f", d2);
 
+    /* The catalog now describes the volume, with its histogram (256 bins
+     * summing to the voxel count: Marschner-Lobb has no NaN) and the ramp
+     * "opacity": "auto" stands for. */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"list_datasets\"}") == 0);
+    cJSON *list = tclient_wait_type(&a, "datasets", T);
+    const cJSON *ml = NULL, *ds;
+    cJSON_ArrayForEach(ds, cJSON_GetObjectItemCaseSensitive(list, "datasets")) {
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(ds, "name");
+        if (cJSON_IsString(name) && strcmp(name->valuestring, "marschner_lobb") == 0)
+            ml = ds;
+    }
+    const cJSON *counts = cJSON_GetObjectItemCaseSensitive(ml, "counts");
+    const cJSON *hist = cJSON_GetObjectItemCaseSensitive(counts, "histogram");
+    const cJSON *dims = cJSON_GetObjectItemCaseSensitive(counts, "dims");
+    const cJSON *ramp = cJSON_GetObjectItemCaseSensitive(counts, "auto_opacity");
+    double sum = 0, voxels = 1;
+    const cJSON *x;
+    cJSON_ArrayForEach(x, hist) sum += x->valuedouble;
+    cJSON_ArrayForEach(x, dims) voxels *= x->valuedouble;
+    SL_CHECK_MSG(cJSON_GetArraySize(hist) == 256 && cJSON_GetArraySize(dims) == 3 && sum == voxels,
+                 "histogram: %d bins summing to %.0f, %.0f voxels", cJSON_GetArraySize(hist), sum, voxels);
+    SL_CHECK(cJSON_GetArraySize(ramp) >= 2);
+    cJSON_Delete(list);
+
+    /* "opacity": "auto" is a valid transfer function and draws the volume. */
+    SL_CHECK(tclient_send(&a, "{\"type\":\"set\",\"params\":{\"transfer_function\":"
+                              "{\"colormap\":\"magma\",\"opacity\":\"auto\"}}}") == 0);
+    uint32_t v3 = 0;
+    deadline = sl_clock_ms() + T;
+    while (!v3 && sl_clock_ms() < deadline && (m = tclient_wait_type(&a, "state", T))) {
+        const cJSON *p = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "patch"), "params");
+        const cJSON *tf = cJSON_GetObjectItemCaseSensitive(p, "transfer_function");
+        const cJSON *op = cJSON_GetObjectItemCaseSensitive(tf, "opacity");
+        if (cJSON_IsString(op) && strcmp(op->valuestring, "auto") == 0)
+            v3 = (uint32_t)cJSON_GetObjectItemCaseSensitive(m, "version")->valuedouble;
+        cJSON_Delete(m);
+    }
+    SL_CHECK_MSG(v3 > 0, "no state patch with the automatic opacity");
+    SL_CHECK(v3 > 0 && tclient_wait_version(&a, v3, T) == 0);
+    sl_image third = tclient_decode_last(&a);
+    double fg3 = foreground_fraction(&third);
+    printf("automatic opacity: foreground %.3f\n", fg3);
+    SL_CHECK_MSG(fg3 > 0.1, "the automatic opacity shows almost nothing (foreground %.3f)", fg3);
+
     sl_image_deinit(&first);
     sl_image_deinit(&second);
+    sl_image_deinit(&third);
     sl_image_deinit(&cli);
     tclient_close(&a);
     SL_CHECK(harness_stop(&h) == 0);

@@ -211,13 +211,16 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
             def_ok = cJSON_GetArrayItem(def, k)->valuedouble == d->def[k];
         break;
     case SL_PARAM_TRANSFER: {
-        /* {"colormap": choices[def[0]], "opacity": [[0, def[1]], [1, def[2]]]} */
+        /* {"colormap": choices[def[0]], "opacity": [[0, def[1]], [1, def[2]]] or "auto"} */
         const cJSON *cm = cJSON_GetObjectItemCaseSensitive(def, "colormap");
         const cJSON *op = cJSON_GetObjectItemCaseSensitive(def, "opacity");
-        def_ok = cJSON_IsString(cm) && strcmp(cm->valuestring, sl_colormap_names[(int)d->def[0]]) == 0 &&
-                 cJSON_GetArraySize(op) == 2 &&
-                 cJSON_GetArrayItem(cJSON_GetArrayItem(op, 0), 1)->valuedouble == d->def[1] &&
-                 cJSON_GetArrayItem(cJSON_GetArrayItem(op, 1), 1)->valuedouble == d->def[2];
+        def_ok = cJSON_IsString(cm) && strcmp(cm->valuestring, sl_colormap_names[(int)d->def[0]]) == 0;
+        if (d->def[1] == SL_TF_AUTO_OPACITY)
+            def_ok = def_ok && cJSON_IsString(op) && strcmp(op->valuestring, "auto") == 0;
+        else
+            def_ok = def_ok && cJSON_GetArraySize(op) == 2 &&
+                     cJSON_GetArrayItem(cJSON_GetArrayItem(op, 0), 1)->valuedouble == d->def[1] &&
+                     cJSON_GetArrayItem(cJSON_GetArrayItem(op, 1), 1)->valuedouble == d->def[2];
         /* colormaps: every name a value may take, in order, each with 17 colours; the
          * middle one is sl_colormap_sample at t = 0.5 (to 1e-3). */
         const cJSON *maps = cJSON_GetObjectItemCaseSensitive(o, "colormaps");
@@ -273,13 +276,18 @@ static void test_transfer_parameter(const sl_technique *t, int i)
     sl_params_init(&base, t->params, t->param_count);
     sl_err err = {0};
     const sl_transfer_function *def = sl_params_transfer(&base, d->name);
-    SL_CHECK_MSG(def->colormap == (int)d->def[0] && def->count == 2 && def->point[1][1] == d->def[2],
-                 "%s.%s: default", t->name, d->name);
+    if (d->def[1] == SL_TF_AUTO_OPACITY)
+        SL_CHECK_MSG(def->colormap == (int)d->def[0] && def->auto_opacity && def->count == 0,
+                     "%s.%s: automatic default", t->name, d->name);
+    else
+        SL_CHECK_MSG(def->colormap == (int)d->def[0] && !def->auto_opacity && def->count == 2 &&
+                     def->point[1][1] == d->def[2], "%s.%s: default", t->name, d->name);
     SL_CHECK(sl_transfer_function_check(d->name, def, &err) == SL_OK);
     const char *good[] = {"[[0, 0, 0, 0, 0], [0.5, 1, 0.5, 0.25, 0.1], [2, 1, 1, 1, 1]]",
                           "{\"colormap\": \"magma\", \"opacity\": [[0, 0], [0.5, 0.2], [1, 1]], \"range\": [-1, 2]}",
-                          "{\"colormap\": \"gray\"}", "[[3, 1, 0, 0, 0.5]]"};
-    for (int g = 0; g < 4; g++) {
+                          "{\"colormap\": \"gray\"}", "[[3, 1, 0, 0, 0.5]]",
+                          "{\"colormap\": \"magma\", \"opacity\": \"auto\", \"range\": [-1, 2]}"};
+    for (int g = 0; g < 5; g++) {
         sl_params p = base;
         cJSON *item = cJSON_Parse(good[g]);
         sl_status st = apply_one(&p, d->name, item, &err);
@@ -297,6 +305,19 @@ static void test_transfer_parameter(const sl_technique *t, int i)
     const sl_transfer_function *tf = sl_params_transfer(&p, d->name);
     SL_CHECK(tf->colormap == -1 && tf->count == 3 && tf->point[1][0] == 0.5 && tf->point[1][3] == 0.25 &&
              tf->point[2][4] == 1.0);
+    /* "auto" differs from an explicit ramp and from no ramp. */
+    sl_params pa = base, pr = base;
+    SL_CHECK(apply_one(&pa, d->name, cJSON_Parse("{\"colormap\": \"gray\", \"opacity\": \"auto\"}"), &err) == SL_OK);
+    SL_CHECK(apply_one(&pr, d->name, cJSON_Parse("{\"colormap\": \"gray\"}"), &err) == SL_OK);
+    SL_CHECK(sl_params_transfer(&pa, d->name)->auto_opacity && sl_params_transfer(&pa, d->name)->count == 0);
+    SL_CHECK(sl_params_compare(&pa, &pr) == d->invalidates);
+    /* An automatic ramp in the points form, or with points, is not a function. */
+    sl_transfer_function bad = *sl_params_transfer(&pa, d->name);
+    bad.colormap = -1;
+    SL_CHECK(sl_transfer_function_check(d->name, &bad, &err) == SL_ERR_INVALID && strstr(err.message, "automatic"));
+    bad = *sl_params_transfer(&pa, d->name);
+    bad.count = 1;
+    SL_CHECK(sl_transfer_function_check(d->name, &bad, &err) == SL_ERR_INVALID);
 
     expect_tf_refused(&base, d, "[[0, 0, 0, 0, 0], [1, 1, 1, 1, 1.5]]", (const char *[]){"point 1", "alpha", "[0, 1]", NULL});
     expect_tf_refused(&base, d, "[[0, 0, 0, 0, 0], [1, 1, 1, 1, 1], [0.5, 0, 0, 0, 0]]",
@@ -315,6 +336,8 @@ static void test_transfer_parameter(const sl_technique *t, int i)
     expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"opacity\": [[0, 2]]}",
                       (const char *[]){"point 0", "alpha", NULL});
     expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"ramp\": []}", (const char *[]){"ramp", NULL});
+    expect_tf_refused(&base, d, "{\"colormap\": \"gray\", \"opacity\": \"automatic\"}",
+                      (const char *[]){"\"auto\"", "automatic", NULL});
     char many[4096] = "[";
     for (int k = 0; k < SL_TF_MAX_POINTS + 1; k++)
         snprintf(many + strlen(many), sizeof many - strlen(many), "%s[%d, 0, 0, 0, 0]", k ? "," : "", k);

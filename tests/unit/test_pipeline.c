@@ -112,8 +112,14 @@ static int move_param(sl_params *p, int i, sl_err *err)
         n = 3;
         break;
     case SL_PARAM_TRANSFER: {
-        /* Another opacity at the last point of the ramp or point list. */
+        /* Another opacity at the last point of the ramp or point list (an
+         * automatic ramp becomes an explicit one). */
         sl_transfer_function tf = *sl_params_transfer(p, d->name);
+        if (tf.auto_opacity) {
+            tf.auto_opacity = 0;
+            tf.count = 2;
+            tf.point[1][0] = 1.0;
+        }
         int last = tf.count - 1, alpha = tf.colormap >= 0 ? 1 : 4;
         tf.point[last][alpha] = tf.point[last][alpha] > 0.5 ? 0.25 : 0.75;
         return sl_params_set_transfer(p, d->name, &tf, err) == SL_OK;

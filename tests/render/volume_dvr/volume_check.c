@@ -3,7 +3,7 @@
  * usage: volume-check compare --dataset SRC [--size N] [--orbit AZ,EL,DIST] --params JSON
  *                     [--tol-mean M] [--tol-max X] [--depth-tol F] [--max-miss-pct P]
  *                     [--ref-step S] [--ref-uncorrected 1] [--skipping-equal 1] [--max-samples N]
- *                     [--min-skipped F] [--save PREFIX]
+ *                     [--min-skipped F] [--interactive 1] [--save PREFIX]
  *        volume-check work --dataset SRC
  * SRC: generator JSON ({"generator": ...}), a file path, or synthetic:NAME
  * (constant, line, slab, aniso, huge, nan). compare renders one frame with
@@ -15,7 +15,8 @@
  * of every pixel (0..255 units) and, for iso, the distance error over pixels
  * both hit relative to the box diagonal and the pixels hit by one only.
  * --skipping-equal also renders with empty-space skipping off: identical
- * image required. work checks sl_volume_counters and re-prepares across
+ * image required. --interactive renders the frame as an interactive one
+ * (view.quality; the reference still takes the params' step or --ref-step). work checks sl_volume_counters and re-prepares across
  * camera moves and parameter changes. Exit 0 ok, 1 "check failed: ...", 2 setup.
  */
 #include <cjson/cJSON.h>
@@ -103,7 +104,7 @@ static int make_view(const sl_dataset *ds, const double orbit[3], int size, sl_v
 
 typedef struct options {
     const char *cmd, *dataset, *params, *save;
-    int size, skipping_equal, ref_uncorrected;
+    int size, skipping_equal, ref_uncorrected, interactive;
     double orbit[3], tol_mean, tol_max, depth_tol, max_miss_pct, ref_step, max_samples, min_skipped;
 } options;
 
@@ -134,6 +135,7 @@ static int parse(int argc, char **argv, options *o)
         else if (strcmp(k, "--min-skipped") == 0) o->min_skipped = atof(v);
         else if (strcmp(k, "--skipping-equal") == 0) o->skipping_equal = atoi(v);
         else if (strcmp(k, "--ref-uncorrected") == 0) o->ref_uncorrected = atoi(v);
+        else if (strcmp(k, "--interactive") == 0) o->interactive = atoi(v);
         else return 0;
     }
     return o->dataset && o->size > 0 && o->size <= 1024;
@@ -251,6 +253,8 @@ static int compare(const options *o)
         rig_deinit(&r);
         return 2;
     }
+    if (o->interactive)
+        view.quality = SL_QUALITY_INTERACTIVE;
     size_t n = (size_t)o->size * o->size;
     uint8_t *gpu = malloc(n * 4), *ref = malloc(n * 4), *gpu2 = malloc(n * 4);
     float *gd = malloc(n * sizeof *gd), *rd = malloc(n * sizeof *rd);
