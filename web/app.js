@@ -334,11 +334,14 @@ conn.addEventListener('disconnect', () => {
 
 // A dataset of a kind the current technique does not render brings the
 // first technique that does, in the same scene message: the server never
-// sees an unfit pair from the page.
+// sees an unfit pair from the page. The new dataset is framed: same viewing
+// direction, default distance, no pan (camera.framed).
 $('dataset').addEventListener('change', (e) => {
   const kind = datasetByName(e.target.value)?.kind;
   const current = techniqueByName(app.state?.technique);
   const msg = { type: 'scene', dataset: e.target.value };
+  const framed = camera.framed();
+  if (framed) msg.camera = framed;
   if (kind && !(current?.dataset_kinds || []).includes(kind)) {
     const t = techniquesFor(kind)[0];
     if (!t) { fillPickers(); setBanner(`no technique renders ${kind} datasets`); return; }

@@ -61,6 +61,16 @@ export class CameraControl {
     }
   }
 
+  // The camera for a newly chosen dataset: the same viewing direction, the
+  // default distance, no pan (an eye/target of another dataset's coordinates
+  // would put the view anywhere). Taken over locally at once.
+  framed() {
+    if (!this.orbit || !this.defaults) return null;
+    this.orbit = { ...this.orbit, distance: this.defaults.orbit.distance };
+    this.pan = [0, 0, 0];
+    return { orbit: { ...this.orbit }, fov_y: this.fov };
+  }
+
   centre() {
     const [lo, hi] = this.bounds;
     return lo.map((l, i) => (l + hi[i]) / 2);

@@ -19,6 +19,7 @@ import { throttle } from './throttle.js';
 
 const W = 256, H = 96, R = 5;   // canvas size (CSS scales it), point radius in canvas pixels
 const MAX_POINTS = 64;
+const AUTO = '@auto';            // the preset that asks for "opacity": "auto"
 
 const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
 const lerp = (a, b, f) => a + (b - a) * f;
@@ -48,6 +49,7 @@ export class TransferFunctionEditor {
       : [[0, 0], [1, 0.2]];
     this.points = [];      // { t in 0..1 over the range, rgb: [r, g, b] | null (from the colormap), a }
     this.colormap = null;  // colormap form: its name
+    this.auto = false;     // colormap form with "opacity": "auto" (until a point moves)
     this.range = null;     // [lo, hi] in data units, or null (the dataset's, not known here)
     this.selected = -1;
     this.send = throttle(() => onChange(this.value()), 100);
@@ -62,8 +64,9 @@ export class TransferFunctionEditor {
     this.canvas.title = 'drag a point: value (x) and opacity (y); double-click adds a point, Delete removes the selected one';
     this.preset = document.createElement('select');
     this.preset.name = `${def.name}.preset`;
-    this.preset.append(new Option('points', ''), ...[...this.colormaps.keys()].map((n) => new Option(n, n)));
-    this.preset.title = 'colormap preset (keeps the opacity curve)';
+    this.preset.append(new Option('points', ''), ...[...this.colormaps.keys()].map((n) => new Option(n, n)),
+      new Option('auto opacity', AUTO));
+    this.preset.title = 'colormap preset (keeps the opacity curve), or the automatic opacity ramp the server picks from the histogram';
     this.color = document.createElement('input');
     this.color.type = 'color';
     this.color.name = `${def.name}.color`;
@@ -115,6 +118,7 @@ export class TransferFunctionEditor {
   // Shows a value from the session (welcome or state patch); ignored while dragging.
   set(v) {
     if (this.dragging) return;
+    this.auto = !!(v && v.opacity === 'auto');
     if (Array.isArray(v)) {
       this.colormap = null;
       const lo = v[0][0], hi = v[v.length - 1][0];
@@ -145,7 +149,7 @@ export class TransferFunctionEditor {
   value() {
     const r4 = (x) => Math.round(x * 1e4) / 1e4;
     if (this.colormap) {
-      const v = { colormap: this.colormap, opacity: this.points.map((p) => [r4(p.t), r4(p.a)]) };
+      const v = { colormap: this.colormap, opacity: this.auto ? 'auto' : this.points.map((p) => [r4(p.t), r4(p.a)]) };
       if (this.range) v.range = this.range;
       return v;
     }
@@ -165,10 +169,21 @@ export class TransferFunctionEditor {
   }
 
   applyPreset(name) {
+    if (name === AUTO) {
+      // The automatic ramp spans the dataset's own value range (a range kept
+      // from another dataset would misplace it).
+      if (!this.colormap) this.colormap = this.colormaps.has('viridis') ? 'viridis' : [...this.colormaps.keys()][0];
+      this.range = null;
+      this.points = this.ramp('auto').map((p) => ({ t: p[0], rgb: null, a: p[1] }));
+      this.auto = true;
+      this.preset.value = this.colormap;
+      this.changed(true, true);
+      return;
+    }
     if (!name) { if (!this.toPoints()) this.preset.value = this.colormap; else this.changed(true); return; }
     this.colormap = name;
     for (const p of this.points) p.rgb = null;
-    this.changed(true);
+    this.changed(true, true);
   }
 
   recolour(rgb) {
@@ -177,7 +192,9 @@ export class TransferFunctionEditor {
     this.changed(false);
   }
 
-  changed(final) {
+  // Every edit but a colormap preset makes the ramp explicit.
+  changed(final, keepAuto = false) {
+    if (!keepAuto) this.auto = false;
     this.draw();
     this.send(final);
   }

@@ -9,8 +9,8 @@
 // outer loop looks up the brick of the next sample and its run d (the cube of bricks
 // within d - 1 of it is of its kind); in an invisible brick (composite: zero opacity
 // for every value in it; iso: iso outside its range) it jumps to the first sample
-// past that cube, and, for mip, past a brick (where a run starts) whose maximum cannot
-// raise the running maximum; in a visible one the inner loop takes every sample up to the cube's exit
+// past that cube (mip: visible bricks are looked up one by one, and one whose maximum
+// cannot raise the running maximum is skipped); in a visible one the inner loop takes every sample up to the cube's exit
 // without further lookups. The same samples are kept, so the image is unchanged.
 // NaN samples are transparent (iso: no crossing next to them). Writes the final
 // colour (blending off) and the depth: iso hit, composite where alpha first exceeds
@@ -141,11 +141,11 @@ void main()
             bool skip = code < RUN_VISIBLE;
             uint run = skip ? code : code - RUN_VISIBLE;
 #if SL_MODE == 1
-            // A brick whose maximum cannot raise the running one is skipped on
-            // its own. Only tested where a run starts: testing every brick (runs
-            // of one) skipped 29 % of the CT's samples but cost 1.4x the time.
-            if (!skip && texelFetch(u_minmax, b, 0).g <= vmax) {
-                skip = true;
+            // Visible bricks one at a time, each skipped when its maximum
+            // cannot raise the running one (head phantom at 1280x720: 362 ms,
+            // 90 % skipped; as runs without the test, 843 ms).
+            if (!skip) {
+                skip = texelFetch(u_minmax, b, 0).g <= vmax;
                 run = 1u;
             }
 #endif

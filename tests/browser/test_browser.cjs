@@ -53,6 +53,12 @@ function startServer(dir, port = 0) {
     fs.mkdirSync(data);
     execFileSync(SERVER, ['catalog', 'add-generator', 'tiny', TINY, '--db', db, '--data-dir', data], { stdio: 'ignore' });
     execFileSync(SERVER, ['catalog', 'add-generator', 'tiny2', TINY2, '--db', db, '--data-dir', data], { stdio: 'ignore' });
+    // The MRI sample, when fetched: <data-dir>/samples is registered at start.
+    const mri = path.join(SRC, 'data', 'samples', 'ch2.nii.gz');
+    if (fs.existsSync(mri)) {
+      fs.mkdirSync(path.join(data, 'samples'));
+      fs.copyFileSync(mri, path.join(data, 'samples', 'ch2.nii.gz'));
+    }
   }
   const proc = spawn(SERVER, ['--port', String(port), '--db', db, '--data-dir', data, '--web-dir', path.join(SRC, 'web'),
     '--default-dataset', 'tiny'], { stdio: ['ignore', 'pipe', 'inherit'] });
@@ -316,19 +322,35 @@ async function volumeScene(page, obs, sess, banner) {
   check((await cv.count()) === 1, `${tfDef.name} has an editor canvas`);
   await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
     d.name === window.sightline.state.dataset)?.counts?.value_range), null, { timeout: T });
+  // The default is the colormap form with "opacity": "auto": the editor shows
+  // the ramp the catalog lists for the dataset, over its histogram.
   const tf0 = st.params[tfDef.name];
-  const last = tf0.opacity.length - 1;
+  const counts = await page.evaluate(() => window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset).counts);
+  check(tf0.opacity === 'auto' && Array.isArray(counts.auto_opacity) && counts.auto_opacity.length >= 2,
+    `default transfer function ${JSON.stringify(tf0)} with the listed ramp ${JSON.stringify(counts.auto_opacity)}`);
+  check(Array.isArray(counts.histogram) && counts.histogram.length === 256, `the catalog lists a 256-bin histogram`);
+  const ramp0 = Array.isArray(tf0.opacity) ? tf0.opacity : counts.auto_opacity;
+  const histogramPixels = () => page.$eval(`#params canvas[data-param=${tfDef.name}]`, (c) => {
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height - 8).data;
+    let n = 0;   // the histogram's grey bars: rgba(160, 165, 180, 0.35) on a clear canvas
+    for (let i = 0; i < d.length; i += 4) if (d[i + 3] > 60 && d[i + 3] < 120 && Math.abs(d[i] - 160) < 12) n++;
+    return n / (c.width * (c.height - 8));
+  });
+  const hp = await histogramPixels();
+  check(hp > 0.05, `the editor draws the histogram behind the curve (${(100 * hp).toFixed(1)} % of the canvas)`);
+  const last = ramp0.length - 1;
   let box = await cv.boundingBox();
   const at = (t, a) => [box.x + Math.min(t * box.width, box.width - 1), box.y + (1 - a) * box.height];
   await page.evaluate(() => { window.sightline.sent.length = 0; });
-  const [x0, y0] = at(tf0.opacity[last][0], tf0.opacity[last][1]);
+  const [x0, y0] = at(ramp0[last][0], ramp0[last][1]);
   await page.mouse.move(x0, y0);
   await page.mouse.down();
   for (let i = 1; i <= 20; i++) await page.mouse.move(x0, y0 + (at(1, 0.6)[1] - y0) * i / 20);
   await page.mouse.up();
   const moved = await serverStateWhere(obs, sess, (s) => {
     const v = s.params[tfDef.name];
-    return v && v.colormap === tf0.colormap && Math.abs(v.opacity[last][1] - 0.6) < 0.03;
+    return v && v.colormap === tf0.colormap && Array.isArray(v.opacity) && Math.abs(v.opacity[last][1] - 0.6) < 0.03;
   }, 'tf drag');
   check(moved, `dragged point ${last} reached the server: opacity ${JSON.stringify(moved && moved.params[tfDef.name].opacity)}`);
   const tfSets = await page.evaluate((n) => window.sightline.sent.filter((m) => m.type === 'set' && m.params &&
@@ -349,7 +371,6 @@ async function volumeScene(page, obs, sess, banner) {
   }, 'tf colour');
   check(coloured, `point ${last} coloured #ff0000 at value ${range[1]} on the server`);
   await settled(page);
-  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
 
   // A preset: back to the colormap form with that colormap.
   const preset = tfDef.colormaps.find((m) => m.name !== tf0.colormap).name;
@@ -357,6 +378,36 @@ async function volumeScene(page, obs, sess, banner) {
   check(await serverStateWhere(obs, sess, (s) => s.params[tfDef.name].colormap === preset, 'tf preset'),
     `preset ${preset} on the server`);
   await settled(page);
+
+  // The Colin27 MRI sample (data/samples, when fetched), back on the
+  // automatic opacity (the editor's preset: the session kept the edited
+  // transfer function across the dataset switch): the head shows. The
+  // screenshot browser-test-volume.png is this frame with its editor.
+  const mri = info.datasets.find((d) => d.kind === 'volume' && /ch2/.test(d.name));
+  if (!mri) {
+    console.log('browser test: the MRI sample ch2.nii.gz is not in the catalog (scripts/fetch-sample-data); no MRI frame');
+    await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
+    return;
+  }
+  await page.selectOption('#dataset', mri.name);
+  check(await serverStateWhere(obs, sess, (s) => s.dataset === mri.name && Array.isArray(s.bounds), 'MRI', 60000),
+    `${mri.name} loaded`);
+  await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.auto_opacity), null, { timeout: T });
+  await page.selectOption(`#params select[name="${tfDef.name}.preset"]`, '@auto');
+  const ms = await serverStateWhere(obs, sess, (s) => s.params[tfDef.name] && s.params[tfDef.name].opacity === 'auto',
+    'auto preset');
+  check(ms, `the preset asks for the automatic opacity (${JSON.stringify(ms && ms.params[tfDef.name])})`);
+  await page.waitForFunction(() => window.sightline.lastFrame && !window.sightline.lastFrame.interactive &&
+    window.sightline.lastFrame.stateVersion >= window.sightline.stateVersion, null, { timeout: 3 * T });
+  await page.waitForFunction(() => Array.isArray(window.sightline.datasets.find((d) =>
+    d.name === window.sightline.state.dataset)?.counts?.histogram), null, { timeout: T });
+  const mf = await canvasStats(page);
+  check(mf.fg > 0.05 && mf.fg < 0.95, `the MRI head shows (foreground ${mf.fg.toFixed(3)})`);
+  await settled(page);
+  const mh = await histogramPixels();
+  check(mh > 0.05, `the MRI's histogram is behind its editor (${(100 * mh).toFixed(1)} %)`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
 }
 
 // The two attribute rules of controls.js on a synthetic schema, so they
