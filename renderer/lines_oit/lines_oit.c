@@ -2,7 +2,7 @@
  * per-pixel linked lists and per-pixel sorting, the transparency baseline of
  * Kanzler et al. (TVCG 2018, Sec. 5.3 and Table 2; lists after Yang et al.).
  *
- * prepare builds the swept tube mesh once (tubes_mesh_build.h, no caps, the
+ * prepare builds the swept tube mesh once (lines/sl_tube_mesh.h, no caps, the
  * front half of each tube is stored, so each tube crossing a pixel gives one
  * fragment). render: pass 1 rasterizes all tubes and appends every fragment
  * to its pixel's list in a node pool; pass 2 sorts each list by depth and
@@ -19,7 +19,7 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
-#include "../tubes_mesh/tubes_mesh_build.h"
+#include "../lines/sl_tube_mesh.h"
 
 #define NODE_BYTES 12u
 #define NIL 0x7fffffffu

@@ -2,7 +2,7 @@
  *
  * The tessellation baseline of the spline-tube (Russig et al.) and voxel-line
  * (Kanzler et al.) papers, and the first thing a user sees. prepare builds
- * the mesh on the CPU (tubes_mesh_build.c) and uploads it once; the radius
+ * the mesh on the CPU (lines/tube_mesh.c) and uploads it once; the radius
  * and every shading parameter are uniforms, so only `sides`, `caps` and
  * `radius_attribute` (per-vertex radii |value| from an attribute, baked into
  * the mesh like the data's own radii) re-prepare. One indexed draw per frame. `opacity` (shared by name with
@@ -20,7 +20,7 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
-#include "tubes_mesh_build.h"
+#include "../lines/sl_tube_mesh.h"
 
 static const sl_param_def tubes_mesh_params[] = {
     SL_LINE_STYLE_PARAMS,
