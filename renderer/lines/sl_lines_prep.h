@@ -41,11 +41,12 @@ size_t sl_lines_kept(const sl_lines *l, size_t line, size_t *kept);
 size_t sl_lines_tangents(const sl_lines *l, sl_lines_tangent_rule rule, float *t3);
 
 /* Rotation-minimizing normals by projection transport along BISECTOR
- * tangents t3: n0 = seed3[first] projected off t0 (NULL or a projection
- * shorter than 0.5: any vector orthogonal to t0), then n_k = normalize(n_{k-1}
- * - t_k (n_{k-1}.t_k)), re-seeded when shorter than 0.5. Dropped vertices
- * copy the normal of their kept vertex; lines without a segment get (1,0,0).
- * Unit and orthogonal to t3 wherever t3 is non-zero. */
+ * tangents t3: n0 = normalize(seed3[first] projected off t0) (seed3 NULL,
+ * non-finite, or parallel to t0: any vector orthogonal to t0), then n_k =
+ * normalize(n_{k-1} - t_k (n_{k-1}.t_k)), re-seeded the same way when that
+ * projection vanishes. Dropped vertices copy the normal of their kept
+ * vertex; lines without a segment get (1,0,0). Unit and orthogonal to t3
+ * wherever t3 is non-zero. */
 void sl_lines_transport_normals(const sl_lines *l, const float *t3, const float *seed3, float *n3);
 
 /* Given normals (3 per vertex) projected off t3, normalized and
