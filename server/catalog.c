@@ -392,8 +392,11 @@ sl_status sl_catalog_set_info(sqlite3 *db, const char *name, const char *bounds,
                                const char *attrs, sl_err *err)
 {
     sqlite3_stmt *q = NULL;
+    /* Fills a row not described yet, and refreshes a volume described before
+     * catalogs kept histograms (a catalog file from an older version). */
     if (sqlite3_prepare_v2(db, "UPDATE datasets SET bounds = ?2, counts = ?3, attributes = ?4"
-                               " WHERE name = ?1 AND bounds IS NULL", -1, &q, NULL) != SQLITE_OK)
+                               " WHERE name = ?1 AND (bounds IS NULL OR (kind <> 'lines' AND"
+                               " json_type(counts, '$.histogram') IS NULL))", -1, &q, NULL) != SQLITE_OK)
         return db_fail(db, err, "prepare set_info");
     sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(q, 2, bounds, -1, SQLITE_TRANSIENT);

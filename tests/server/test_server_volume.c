@@ -3,11 +3,14 @@
  * matches sightline-render of the same scene up to JPEG), a `set` of a bad
  * transfer-function point is a bad_param error naming the point, a valid new
  * transfer function changes the frame, the catalog then lists the volume's
- * histogram, and "opacity": "auto" draws it. Starts its own server (sl_server_harness.h).
+ * histogram, "opacity": "auto" draws it, and a catalog row described before
+ * histograms existed is described again when the volume is opened. Starts its own server (sl_server_harness.h).
  */
+#include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "image/sl_image.h"
 #include "sl_server_harness.h"
@@ -153,6 +156,36 @@ int main(void)
     double fg3 = foreground_fraction(&third);
     printf("automatic opacity: foreground %.3f\n", fg3);
     SL_CHECK_MSG(fg3 > 0.1, "the automatic opacity shows almost nothing (foreground %.3f)", fg3);
+
+    /* A catalog written before histograms existed (the row described, its
+     * counts without histogram): the next time a session opens the volume,
+     * the row is described again. */
+    sqlite3 *db = NULL;
+    SL_CHECK(sqlite3_open(h.db, &db) == SQLITE_OK);
+    sqlite3_busy_timeout(db, 5000);
+    SL_CHECK(sqlite3_exec(db, "UPDATE datasets SET counts = json_remove(counts, '$.histogram', '$.auto_opacity')"
+                              " WHERE name = 'marschner_lobb'", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(db);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"tiny\",\"technique\":\"tubes_mesh\"}") == 0);
+    SL_CHECK(tclient_wait_frame(&a, 0, 1, T) == 0);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"marschner_lobb\",\"technique\":\"volume_dvr\"}") == 0);
+    SL_CHECK(wait_technique(&a) > 0);
+    int refreshed = 0;
+    deadline = sl_clock_ms() + T;
+    while (!refreshed && sl_clock_ms() < deadline) {
+        SL_CHECK(tclient_send(&a, "{\"type\":\"list_datasets\"}") == 0);
+        cJSON *again = tclient_wait_type(&a, "datasets", T);
+        cJSON_ArrayForEach(ds, cJSON_GetObjectItemCaseSensitive(again, "datasets")) {
+            const cJSON *name = cJSON_GetObjectItemCaseSensitive(ds, "name");
+            const cJSON *c = cJSON_GetObjectItemCaseSensitive(ds, "counts");
+            if (cJSON_IsString(name) && strcmp(name->valuestring, "marschner_lobb") == 0)
+                refreshed = cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(c, "histogram")) == 256;
+        }
+        cJSON_Delete(again);
+        if (!refreshed)
+            usleep(200000);
+    }
+    SL_CHECK_MSG(refreshed, "a volume row without a histogram was not described again");
 
     sl_image_deinit(&first);
     sl_image_deinit(&second);
