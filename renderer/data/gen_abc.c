@@ -6,7 +6,11 @@
  * [0, 2pi]^3 and are traced forward with RK4 in arc length for a fixed length
  * (SL_ABC_LENGTH), so `points` refines rather than lengthens them; they are
  * not wrapped into the periodic cell (no jumps), so they may leave it by up
- * to that length. Tangents = velocity, attribute "speed" = |v|. Any thread.
+ * to that length. Tangents = velocity, attribute "speed" = |v|, then
+ * "helicity" (curl v).v = |v|^2 and "vorticity_magnitude" |curl v| = |v|,
+ * closed form (curl v = v for any A, B, C: (curl v)_x = dv_z/dy - dv_y/dz =
+ * C cos y + A sin z = v_x, and cyclically), in double at the stored vertex.
+ * Any thread.
  */
 #include "gen_family.h"
 #include "gen_random.h"
@@ -42,7 +46,9 @@ static sl_status abc_generate(const double *values, sl_dataset **out, sl_err *er
     sl_lines *l = &ds->lines;
     sl_status st = sl_lines_alloc(l, lines, lines * points, 0, 1, err);
     float *speed = st == SL_OK ? sl_lines_add_attribute(l, "speed", 0, err) : NULL;
-    if (!speed)
+    float *helicity = speed ? sl_lines_add_attribute(l, SL_ATTR_HELICITY, 0, err) : NULL;
+    float *vorticity = helicity ? sl_lines_add_attribute(l, SL_ATTR_VORTICITY, 0, err) : NULL;
+    if (!vorticity)
         goto fail;
     const double two_pi = 6.283185307179586;
     double h = SL_ABC_LENGTH / (double)(points - 1);
@@ -59,6 +65,12 @@ static sl_status abc_generate(const double *values, sl_dataset **out, sl_err *er
         for (size_t i = base; i < base + points; i++) {
             const float *t = l->tangents + 3 * i;
             speed[i] = (float)sqrt((double)t[0] * t[0] + (double)t[1] * t[1] + (double)t[2] * t[2]);
+            const double q[3] = {l->positions[3 * i], l->positions[3 * i + 1], l->positions[3 * i + 2]};
+            double v[3];
+            abc_field(q, &prm, v); /* = curl v */
+            double vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            helicity[i] = (float)vv;
+            vorticity[i] = (float)sqrt(vv);
         }
     }
     l->line_offsets[lines] = (uint32_t)(lines * points);
@@ -75,7 +87,7 @@ fail:
 const sl_gen_family sl_gen_abc = {
     .name = "abc",
     .kind = SL_DATASET_LINES,
-    .description = "RK4 streamlines of the Arnold-Beltrami-Childress flow in [0,2pi]^3; tangents = velocity, attribute speed",
+    .description = "RK4 streamlines of the Arnold-Beltrami-Childress flow in [0,2pi]^3; tangents = velocity, attributes speed, helicity, vorticity_magnitude",
     .keys_help = "lines (1..1000000, default 500), points per line (2..10000, default 300), seed, "
                  "a (0..10, default sqrt 3), b (0..10, default sqrt 2), c (0..10, default 1)",
     .key_count = 6,

@@ -1,18 +1,25 @@
 /* gen_tornado.c — streamlines of Crawfis' analytic tornado vector field.
  *
  * The field (R. Crawfis' classic test data, tornadoSrc.c, Ohio State; written
- * here from its formula, in double): a helical vortex in [0,1]^3 whose
- * centre (xc, yc) moves with height z and whose radius grows with z; outside
+ * here once from its formula, gen_tornado_field.h, and compiled for double
+ * and for dual numbers that carry its exact derivatives): a helical vortex in
+ * [0,1]^3 whose centre (xc, yc) moves with height z and whose radius grows
+ * with z; outside
  * its core the flow rotates the other way and drifts upward. Lines are traced
  * with RK4 in arc length, backward and forward from a seeded random start
  * point (the forward flow spirals outward); a line that leaves the box
  * [-0.25, 1.25]^2 x [0, 1] (the field's height range) is re-seeded (up to SL_TORNADO_TRIES times; about 70% are
  * kept) so every line has exactly `points` vertices and the same length
  * SL_TORNADO_LENGTH whatever `points` is: more points = finer, not longer.
- * Stores the field value at each vertex as the tangent and |v| as "speed".
+ * Stores the field value at each vertex as the tangent and |v| as "speed",
+ * then "helicity" (curl v).v and "vorticity_magnitude" |curl v| at the stored
+ * vertex, from exact derivatives of the same formula (gen_tornado.h).
  * `time` is the original's phase parameter: it rotates the vortex centre
  * (steady field for each value; 0 by default). Any thread.
  */
+#include "gen_tornado.h"
+
+#include "gen_dual.h"
 #include "gen_family.h"
 #include "gen_random.h"
 #include "gen_trace.h"
@@ -26,35 +33,31 @@
 
 enum { K_LINES, K_POINTS, K_SEED, K_TIME };
 
-/* The vortex at height z: centre (xc, yc), funnel radius r, damping radius r2. */
-static void tornado_slice(double z, double phase, double *xc, double *yc, double *r, double *r2)
-{
-    *xc = 0.5 + 0.1 * sin(0.04 * phase + 10.0 * z);
-    *yc = 0.5 + 0.1 * cos(0.03 * phase + 3.0 * z);
-    *r = 0.1 + 0.4 * z * z + 0.1 * z * sin(8.0 * z);
-    *r2 = 0.2 + 0.1 * z;
-}
+/* The formula twice from one text: plain double for the tracer, dual numbers for the curl. */
+#define SL_TORNADO_NUM double
+#define SL_TORNADO_SLICE tornado_slice
+#define SL_TORNADO_FIELD tornado_real
+#include "gen_tornado_field.h"
+
+#define SL_TORNADO_NUM sl_dual3
+#define SL_TORNADO_SLICE tornado_slice_dual
+#define SL_TORNADO_FIELD tornado_dual
+#include "gen_tornado_field.h"
 
 static void tornado_field(const double p[3], const void *ctx, double v[3])
 {
-    double phase = *(const double *)ctx;
-    double x = p[0], y = p[1], z = p[2], xc, yc, r, r2;
-    tornado_slice(z, phase, &xc, &yc, &r, &r2);
-    double dx = x - xc, dy = y - yc;
-    double dist = sqrt(dx * dx + dy * dy);
-    double scale = fabs(r - dist);
-    scale = scale > r2 ? 0.8 - scale : 1.0;
-    double z0 = 0.1 * (0.1 - dist * z);
-    if (z0 < 0.0)
-        z0 = 0.0;
-    double d3 = sqrt(dist * dist + z0 * z0);
-    scale = (r + r2 - d3) * scale / (d3 + 1e-11);
-    /* The field is singular at z = -1, far below the box; lines never get
-     * there, but a rejected trial line might, so keep it finite. */
-    scale = scale / fmax(1.0 + z, 1e-3);
-    v[0] = scale * dy + 0.1 * dx;
-    v[1] = -scale * dx + 0.1 * dy;
-    v[2] = scale * z0;
+    tornado_real(p, *(const double *)ctx, v);
+}
+
+void sl_gen_tornado_eval(const double p[3], double phase, double v[3], double curl[3])
+{
+    sl_dual3 d[3];
+    tornado_dual(p, phase, d);
+    for (int c = 0; c < 3; c++)
+        v[c] = d[c].v;
+    curl[0] = d[2].d[1] - d[1].d[2];
+    curl[1] = d[0].d[2] - d[2].d[0];
+    curl[2] = d[1].d[0] - d[0].d[1];
 }
 
 static sl_status tornado_generate(const double *values, sl_dataset **out, sl_err *err)
@@ -71,7 +74,9 @@ static sl_status tornado_generate(const double *values, sl_dataset **out, sl_err
     sl_lines *l = &ds->lines;
     sl_status st = sl_lines_alloc(l, lines, lines * points, 0, 1, err);
     float *speed = st == SL_OK ? sl_lines_add_attribute(l, "speed", 0, err) : NULL;
-    if (!speed)
+    float *helicity = speed ? sl_lines_add_attribute(l, SL_ATTR_HELICITY, 0, err) : NULL;
+    float *vorticity = helicity ? sl_lines_add_attribute(l, SL_ATTR_VORTICITY, 0, err) : NULL;
+    if (!vorticity)
         goto fail;
     const double lo[3] = {-0.25, -0.25, 0.0}, hi[3] = {1.25, 1.25, 1.0};
     double h = SL_TORNADO_LENGTH / (double)(points - 1);
@@ -96,6 +101,12 @@ static sl_status tornado_generate(const double *values, sl_dataset **out, sl_err
         for (size_t i = base; i < base + points; i++) {
             const float *t = l->tangents + 3 * i;
             speed[i] = (float)sqrt((double)t[0] * t[0] + (double)t[1] * t[1] + (double)t[2] * t[2]);
+            /* Helicity and vorticity at the stored (float) position, in double. */
+            const double q[3] = {l->positions[3 * i], l->positions[3 * i + 1], l->positions[3 * i + 2]};
+            double v[3], w[3];
+            sl_gen_tornado_eval(q, phase, v, w);
+            helicity[i] = (float)(v[0] * w[0] + v[1] * w[1] + v[2] * w[2]);
+            vorticity[i] = (float)sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
         }
     }
     l->line_offsets[lines] = (uint32_t)(lines * points);
@@ -113,7 +124,7 @@ fail:
 const sl_gen_family sl_gen_tornado = {
     .name = "tornado",
     .kind = SL_DATASET_LINES,
-    .description = "RK4 streamlines of Crawfis' analytic tornado vortex in [0,1]^3; tangents = velocity, attribute speed",
+    .description = "RK4 streamlines of Crawfis' analytic tornado vortex in [0,1]^3; tangents = velocity, attributes speed, helicity, vorticity_magnitude",
     .keys_help = "lines (1..1000000, default 1000), points per line (2..10000, default 200), seed (0..2^53-1, default 1), time phase (0..10000, default 0)",
     .key_count = 4,
     .keys = {

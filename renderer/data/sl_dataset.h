@@ -106,6 +106,12 @@ sl_status sl_lines_alloc(sl_lines *lines, size_t line_count, size_t vertex_count
 #define SL_ATTR_DERIVATIVE_SUFFIX "_derivative"
 #define SL_ATTR_RADIUS_DERIVATIVE "radius_derivative"
 
+/* Per-vertex flow attributes of streamlines (the `tornado` and `abc`
+ * generators; any loaded line set may carry them under these names):
+ * helicity h = (curl v).v and the vorticity magnitude |curl v|. */
+#define SL_ATTR_HELICITY "helicity"
+#define SL_ATTR_VORTICITY "vorticity_magnitude"
+
 /* Adds a zero-filled per-vertex (per_line = 0) or per-line attribute and
  * returns its values array, or NULL (err filled) past SL_MAX_ATTRIBUTES. */
 float *sl_lines_add_attribute(sl_lines *lines, const char *name, int per_line, sl_err *err);

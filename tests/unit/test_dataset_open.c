@@ -57,7 +57,8 @@ int main(void)
     /* root/a, root/b (holding seg.json), root/outside.json, root/a/link.json -> ../outside.json */
     char root[] = "/tmp/sl-dataset-open-XXXXXX";
     SL_CHECK(mkdtemp(root) != NULL);
-    char a[PATH_MAX], b[PATH_MAX], seg[PATH_MAX], outside[PATH_MAX], link[PATH_MAX];
+    /* a and b are short (root is 27 bytes), so gcc can see that seg and link fit. */
+    char a[256], b[256], seg[PATH_MAX], outside[PATH_MAX], link[PATH_MAX];
     snprintf(a, sizeof a, "%s/a", root);
     snprintf(b, sizeof b, "%s/b", root);
     snprintf(seg, sizeof seg, "%s/seg.json", b);

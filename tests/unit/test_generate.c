@@ -21,6 +21,7 @@
 #include "core/sl_clock.h"
 #include "data/gen_family.h"
 #include "data/gen_random.h"
+#include "data/gen_tornado.h"
 #include "data/gen_trace.h"
 #include "data/sl_generate.h"
 #include "sl_test.h"
@@ -273,17 +274,24 @@ static void test_furball(void)
     sl_dataset_destroy(ds);
 }
 
-/* Independent transcription of Crawfis' tornado (time 0), valid in the box.
- * *side is |r - dist| - r2: its sign picks the branch of the field's
- * discontinuous scale switch. */
-static void tornado_ref(const double p[3], double v[3], double *side)
+/* Independent transcription of Crawfis' tornado at time phase `phase`,
+ * valid in the box. branch[] (may be NULL) receives the four quantities whose
+ * sign picks a branch of the piecewise formula: |r - dist| - r2 (the
+ * discontinuous scale switch), r - dist (the kink of |.|), 0.1 - dist z (the
+ * clamp of z0 at 0) and dist (the axis). */
+static void tornado_ref_full(const double p[3], double phase, double v[3], double branch[4])
 {
     double x = p[0], y = p[1], z = p[2];
-    double xc = 0.5 + 0.1 * sin(10.0 * z), yc = 0.5 + 0.1 * cos(3.0 * z);
+    double xc = 0.5 + 0.1 * sin(0.04 * phase + 10.0 * z), yc = 0.5 + 0.1 * cos(0.03 * phase + 3.0 * z);
     double r = 0.1 + 0.4 * z * z + 0.1 * z * sin(8.0 * z), r2 = 0.2 + 0.1 * z;
     double t = hypot(x - xc, y - yc);
     double s = fabs(r - t);
-    *side = s - r2;
+    if (branch) {
+        branch[0] = s - r2;
+        branch[1] = r - t;
+        branch[2] = 0.1 - t * z;
+        branch[3] = t;
+    }
     s = s > r2 ? 0.8 - s : 1.0;
     double z0 = fmax(0.0, 0.1 * (0.1 - t * z));
     double t3 = sqrt(t * t + z0 * z0);
@@ -291,6 +299,14 @@ static void tornado_ref(const double p[3], double v[3], double *side)
     v[0] = s * (y - yc) + 0.1 * (x - xc);
     v[1] = -s * (x - xc) + 0.1 * (y - yc);
     v[2] = s * z0;
+}
+
+/* Time 0; *side is |r - dist| - r2 (see tornado_ref_full). */
+static void tornado_ref(const double p[3], double v[3], double *side)
+{
+    double branch[4];
+    tornado_ref_full(p, 0.0, v, branch);
+    *side = branch[0];
 }
 
 static void abc_ref(const double p[3], double v[3])
@@ -441,6 +457,235 @@ static void test_fields(void)
     if (ds)
         SL_CHECK(ds->lines.attributes[0].max == 0.0f);
     sl_dataset_destroy(ds);
+}
+
+/* ------------------------------------------------ helicity and vorticity */
+
+static void abc_ref_k(const double p[3], const double k[3], double v[3])
+{
+    v[0] = k[0] * sin(p[2]) + k[2] * cos(p[1]);
+    v[1] = k[1] * sin(p[0]) + k[0] * cos(p[2]);
+    v[2] = k[2] * sin(p[1]) + k[1] * cos(p[0]);
+}
+
+/* Curl of a field by central differences of step h, in double. */
+static void curl_fd(void (*f)(const double p[3], const void *ctx, double v[3]), const void *ctx, const double p[3],
+                    double h, double w[3])
+{
+    double j[3][3]; /* j[c][a] = dv_c / dx_a */
+    for (int a = 0; a < 3; a++) {
+        double q[3] = {p[0], p[1], p[2]}, vp[3], vm[3];
+        q[a] = p[a] + h;
+        f(q, ctx, vp);
+        q[a] = p[a] - h;
+        f(q, ctx, vm);
+        for (int c = 0; c < 3; c++)
+            j[c][a] = (vp[c] - vm[c]) / (2.0 * h);
+    }
+    w[0] = j[2][1] - j[1][2];
+    w[1] = j[0][2] - j[2][0];
+    w[2] = j[1][0] - j[0][1];
+}
+
+static void abc_ctx_field(const double p[3], const void *ctx, double v[3])
+{
+    abc_ref_k(p, ctx, v);
+}
+
+static void tornado_ctx_field(const double p[3], const void *ctx, double v[3])
+{
+    tornado_ref_full(p, *(const double *)ctx, v, NULL);
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double dist3(const double a[3], const double b[3])
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return sqrt(dot3(d, d));
+}
+
+/* Attribute 0 stays "speed"; helicity and vorticity_magnitude follow it. */
+static void check_flow_attribute_order(const char *name, const sl_lines *l)
+{
+    SL_CHECK_MSG(l->attribute_count == 3, "%s: %d attributes, want 3", name, l->attribute_count);
+    if (l->attribute_count < 3)
+        return;
+    SL_CHECK_MSG(strcmp(l->attributes[0].name, "speed") == 0, "%s: attribute 0 is '%s'", name, l->attributes[0].name);
+    SL_CHECK_MSG(strcmp(l->attributes[1].name, SL_ATTR_HELICITY) == 0, "%s: attribute 1 is '%s'", name,
+                 l->attributes[1].name);
+    SL_CHECK_MSG(strcmp(l->attributes[2].name, SL_ATTR_VORTICITY) == 0, "%s: attribute 2 is '%s'", name,
+                 l->attributes[2].name);
+    SL_CHECK(sl_lines_find_attribute(l, SL_ATTR_HELICITY) == 1 && sl_lines_find_attribute(l, "vorticity_magnitude") == 2);
+}
+
+/* ABC: curl v = v (checked here by central differences of the reference, not
+ * assumed), so helicity = |v|^2 and vorticity = |v| at every vertex.
+ * Tolerances: the generator evaluates at the float position before
+ * recentring, the test at origin + stored float (<= ~1e-6 apart in [0, 4 pi]);
+ * |grad |v|^2| <= 2 |v| |grad v| <= 2 * 4.2 * 4.2 * sqrt(3) ~ 61, hence an
+ * absolute 1e-4 on top of 1e-5 relative (float storage is 6e-8 relative). */
+static void check_abc_flow(const char *json, const double k[3])
+{
+    sl_dataset *ds = gen(json);
+    if (!ds)
+        return;
+    const sl_lines *l = &ds->lines;
+    check_flow_attribute_order("abc", l);
+    if (l->attribute_count < 3) {
+        sl_dataset_destroy(ds);
+        return;
+    }
+    const float *hel = l->attributes[1].values, *vor = l->attributes[2].values;
+    double worst_curl = 0.0, worst_h = 0.0, worst_w = 0.0;
+    size_t bad_h = 0, bad_w = 0;
+    for (size_t i = 0; i < l->vertex_count; i++) {
+        double p[3], v[3], w[3];
+        world(ds, i, p);
+        abc_ref_k(p, k, v);
+        curl_fd(abc_ctx_field, k, p, 1e-5, w);
+        worst_curl = fmax(worst_curl, dist3(w, v));
+        double h = dot3(w, v), wm = sqrt(dot3(w, w));
+        double eh = fabs(hel[i] - h), ew = fabs(vor[i] - wm);
+        bad_h += eh > 1e-5 * fabs(h) + 1e-4;
+        bad_w += ew > 1e-5 * wm + 1e-5;
+        worst_h = fmax(worst_h, eh / (fabs(h) + 1e-3));
+        worst_w = fmax(worst_w, ew / (wm + 1e-3));
+    }
+    printf("abc %s: |curl_fd v - v| <= %.2g; helicity rel err <= %.2g, vorticity rel err <= %.2g over %zu vertices\n",
+           json, worst_curl, worst_h, worst_w, l->vertex_count);
+    /* Central differences of sin/cos with h = 1e-5: truncation h^2/6 * 4.2 ~ 7e-11, rounding ~1e-16 * 4 / 1e-5. */
+    SL_CHECK_MSG(worst_curl <= 1e-8, "abc: curl by central differences differs from v by %.3g", worst_curl);
+    SL_CHECK_MSG(bad_h == 0, "abc: %zu of %zu vertices with helicity != |v|^2 (worst rel %.3g)", bad_h, l->vertex_count,
+                 worst_h);
+    SL_CHECK_MSG(bad_w == 0, "abc: %zu of %zu vertices with vorticity != |v| (worst rel %.3g)", bad_w, l->vertex_count,
+                 worst_w);
+    sl_dataset_destroy(ds);
+}
+
+/* The smallest |branch quantity| of the tornado at p. */
+static double tornado_margin(const double p[3], double phase)
+{
+    double v[3], b[4];
+    tornado_ref_full(p, phase, v, b);
+    return fmin(fmin(fabs(b[0]), fabs(b[1])), fmin(fabs(b[2]), fabs(b[3])));
+}
+
+/* The generator's dual-number curl against central differences (h = 1e-6) of
+ * the independent transcription, at random points of the box at least 1e-4
+ * from every branch switch (every branch quantity has a gradient < 10, so the
+ * stencil never crosses one). FD error: rounding ~2e-16 |v| / h ~ 1e-9 plus
+ * truncation h^2 |v'''| / 6, |v'''| ~ 6 (r + r2) / d3^4 <= 2e8 at d3 >= z0 ~ 0.01:
+ * ~3e-5 absolute where |curl| ~ 0.3 / d3^2 ~ 3e3, so 1e-5 relative to
+ * max(|curl|, 1) holds with margin. */
+static void test_tornado_curl(void)
+{
+    sl_rng rng;
+    sl_rng_seed(&rng, 13, 0);
+    const double phases[2] = {0.0, 40.0};
+    const int counts[2] = {1000, 300};
+    for (int ph = 0; ph < 2; ph++) {
+        double phase = phases[ph], worst = 0.0, worst_v = 0.0;
+        int n = 0, tried = 0, bad = 0, inner = 0, outer = 0, clamped = 0;
+        while (n < counts[ph] && tried < 100 * counts[ph]) {
+            tried++;
+            double p[3] = {sl_rng_range(&rng, -0.25, 1.25), sl_rng_range(&rng, -0.25, 1.25), sl_rng_range(&rng, 0.0, 1.0)};
+            /* Half of the points within the vortex core's reach, where the field varies fastest. */
+            if (n % 2) {
+                double cx = 0.5 + 0.1 * sin(0.04 * phase + 10.0 * p[2]), cy = 0.5 + 0.1 * cos(0.03 * phase + 3.0 * p[2]);
+                double ang = sl_rng_range(&rng, 0.0, 2.0 * PI), rad = sl_rng_range(&rng, 0.0, 0.6);
+                p[0] = cx + rad * cos(ang);
+                p[1] = cy + rad * sin(ang);
+            }
+            if (tornado_margin(p, phase) < 1e-4)
+                continue;
+            double v[3], w[3], vr[3], b[4], wf[3];
+            sl_gen_tornado_eval(p, phase, v, w);
+            tornado_ref_full(p, phase, vr, b);
+            curl_fd(tornado_ctx_field, &phase, p, 1e-6, wf);
+            double e = dist3(w, wf) / fmax(sqrt(dot3(wf, wf)), 1.0);
+            double ev = dist3(v, vr) / fmax(sqrt(dot3(vr, vr)), 1.0);
+            worst = fmax(worst, e);
+            worst_v = fmax(worst_v, ev);
+            bad += e > 1e-5 || ev > 1e-12;
+            inner += b[0] <= 0.0;
+            outer += b[0] > 0.0;
+            clamped += b[2] < 0.0;
+            n++;
+        }
+        printf("tornado phase %g: dual curl vs central differences, worst rel %.2g (value %.2g) at %d points "
+               "(%d inner, %d outer branch, %d with z0 clamped)\n",
+               phase, worst, worst_v, n, inner, outer, clamped);
+        SL_CHECK_MSG(n == counts[ph], "tornado: only %d points away from branch switches", n);
+        SL_CHECK_MSG(bad == 0, "tornado phase %g: %d of %d points with the dual curl off by > 1e-5 (worst %.3g) or "
+                     "the value off by > 1e-12 (worst %.3g)", phase, bad, n, worst, worst_v);
+        SL_CHECK_MSG(inner >= 100 && outer >= 100 && clamped >= 50, "tornado: branches not all sampled (%d %d %d)",
+                     inner, outer, clamped);
+    }
+    /* On the axis (dist = 0) the curl stays finite (sqrt's gradient at 0 is taken as 0). */
+    double v[3], w[3];
+    double axis[3] = {0.5 + 0.1 * sin(10.0 * 0.5), 0.5 + 0.1 * cos(3.0 * 0.5), 0.5};
+    sl_gen_tornado_eval(axis, 0.0, v, w);
+    SL_CHECK_MSG(isfinite(w[0]) && isfinite(w[1]) && isfinite(w[2]), "tornado: curl on the axis %g %g %g", w[0], w[1],
+                 w[2]);
+}
+
+/* Tornado attributes at the vertices against v . curl and |curl| of the
+ * reference by central differences at origin + stored position (the
+ * generator evaluates at the float position before recentring: <= ~1e-7
+ * apart, times |grad curl| ~ 1 / d3^3: a 1e-4 relative tolerance). */
+static void test_tornado_flow(void)
+{
+    sl_dataset *ds = gen("{\"generator\":\"tornado\",\"lines\":60,\"points\":100,\"seed\":15}");
+    if (!ds)
+        return;
+    const sl_lines *l = &ds->lines;
+    check_flow_attribute_order("tornado", l);
+    if (l->attribute_count >= 3) {
+        const float *hel = l->attributes[1].values, *vor = l->attributes[2].values;
+        double phase = 0.0, worst_h = 0.0, worst_w = 0.0;
+        size_t checked = 0, bad = 0;
+        int negative = 0, positive = 0;
+        for (size_t i = 0; i < l->vertex_count; i++) {
+            double p[3], v[3], w[3];
+            world(ds, i, p);
+            if (tornado_margin(p, phase) < 1e-3)
+                continue;
+            tornado_ref_full(p, phase, v, NULL);
+            curl_fd(tornado_ctx_field, &phase, p, 1e-6, w);
+            double h = dot3(v, w), wm = sqrt(dot3(w, w));
+            double eh = fabs(hel[i] - h) / fmax(sqrt(dot3(v, v)) * wm, 1e-3);
+            double ew = fabs(vor[i] - wm) / fmax(wm, 1e-3);
+            bad += eh > 1e-4 || ew > 1e-4;
+            worst_h = fmax(worst_h, eh);
+            worst_w = fmax(worst_w, ew);
+            negative += h < 0.0;
+            positive += h > 0.0;
+            checked++;
+        }
+        printf("tornado: helicity err <= %.2g |v||curl|, vorticity rel err <= %.2g at %zu vertices (%d h > 0, %d h < 0)\n",
+               worst_h, worst_w, checked, positive, negative);
+        SL_CHECK_MSG(checked > 3000, "tornado: only %zu vertices checked", checked);
+        SL_CHECK_MSG(bad == 0, "tornado: %zu of %zu vertices with helicity / vorticity off (worst %.3g, %.3g)", bad,
+                     checked, worst_h, worst_w);
+        SL_CHECK_MSG(positive > 0 && negative > 0, "tornado: helicity of one sign only (%d > 0, %d < 0)", positive,
+                     negative);
+        SL_CHECK(all_finite(ds));
+    }
+    sl_dataset_destroy(ds);
+}
+
+static void test_flow_attributes(void)
+{
+    const double classic[3] = {sqrt(3.0), sqrt(2.0), 1.0}, other[3] = {0.5, 2.0, 1.5}, zero[3] = {0.0, 0.0, 0.0};
+    check_abc_flow("{\"generator\":\"abc\",\"lines\":30,\"points\":200,\"seed\":4}", classic);
+    check_abc_flow("{\"generator\":\"abc\",\"lines\":10,\"points\":100,\"seed\":2,\"a\":0.5,\"b\":2,\"c\":1.5}", other);
+    check_abc_flow("{\"generator\":\"abc\",\"lines\":2,\"points\":5,\"a\":0,\"b\":0,\"c\":0}", zero);
+    test_tornado_curl();
+    test_tornado_flow();
 }
 
 /* v = (-y, x, 0): unit-speed circles; in arc length the exact point after
@@ -757,6 +1002,13 @@ static void test_info_tool(void)
         SL_CHECK(a0 && strcmp(cJSON_GetObjectItem(a0, "name")->valuestring, "speed") == 0);
         SL_CHECK(a0 && cJSON_GetObjectItem(a0, "min")->valuedouble <= cJSON_GetObjectItem(a0, "max")->valuedouble &&
                  cJSON_GetObjectItem(a0, "max")->valuedouble > 0.0);
+        /* The flow attributes follow speed; the tornado's helicity takes both signs. */
+        cJSON *a1 = cJSON_GetArrayItem(attrs, 1), *a2 = cJSON_GetArrayItem(attrs, 2);
+        SL_CHECK(cJSON_GetArraySize(attrs) == 3);
+        SL_CHECK(a1 && strcmp(cJSON_GetObjectItem(a1, "name")->valuestring, SL_ATTR_HELICITY) == 0 &&
+                 cJSON_GetObjectItem(a1, "min")->valuedouble < 0.0 && cJSON_GetObjectItem(a1, "max")->valuedouble > 0.0);
+        SL_CHECK(a2 && strcmp(cJSON_GetObjectItem(a2, "name")->valuestring, SL_ATTR_VORTICITY) == 0 &&
+                 cJSON_GetObjectItem(a2, "min")->valuedouble >= 0.0);
         /* Same call in process: same bounds. */
         sl_dataset *ds = gen("{\"generator\":\"tornado\",\"lines\":25,\"points\":40,\"seed\":7}");
         cJSON *bmin = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "bounds"), "min");
@@ -900,9 +1152,9 @@ static void test_fingerprints(void)
     static const struct { const char *call; fingerprint fp; } pinned[] = {
         /* SL_PRINT_FINGERPRINTS=1 output (x86-64, Debian 12 glibc 2.36, clang). */
     {"{\"generator\":\"tornado\",\"lines\":12,\"points\":40,\"seed\":3}",
-     {12u, 480u, 0x42c472b71a3e5c45ull, {{719.96560938144103, 1052.5344542675259, 726.44823130453005}, {0, 0, 0}, {89.861844252794981, 131.14633124092438, 89.861844252794981}, {-7.5544770321612305, -11.328233461377078, 119.58155572996111}}}},
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{719.96560938144103, 1052.5344542675259, 726.44823130453005}, {0, 0, 0}, {1004.469667857833, 1470.8261437422723, 1204.1086947519507}, {-7.5544770321612305, -11.328233461377078, 119.58155572996111}}}},
     {"{\"generator\":\"abc\",\"lines\":12,\"points\":40,\"seed\":3}",
-     {12u, 480u, 0x42c472b71a3e5c45ull, {{4402.1141907572746, 6429.4883923209636, 4671.4461830258369}, {0, 0, 0}, {1233.585008263588, 1803.0614530902631, 1233.585008263588}, {154.46864795940928, 225.0093947214861, 1860.010295356391}}}},
+     {12u, 480u, 0x42c472b71a3e5c45ull, {{4402.1141907572746, 6429.4883923209636, 4671.4461830258369}, {0, 0, 0}, {5839.2904967069626, 8529.050227857535, 5839.2904967069626}, {154.46864795940928, 225.0093947214861, 1860.010295356391}}}},
     {"{\"generator\":\"bundle\",\"lines\":12,\"points\":40,\"seed\":3}",
      {12u, 480u, 0x42c472b71a3e5c45ull, {{106.74300057906657, 155.84213819985183, 624.44715165067464}, {0, 0, 0}, {1004.4982829913497, 1467.5604803149515, 1004.4982829913497}, {0, 0, 0}}}},
     {"{\"generator\":\"furball\",\"segments\":2000,\"seed\":3}",
@@ -980,6 +1232,7 @@ int main(void)
     test_furball();
     test_random_walk();
     test_fields();
+    test_flow_attributes();
     test_random();
     test_tracer();
     test_hotroom();
