@@ -15,8 +15,10 @@
  * the ellipse per camera against the reference lambda. Twist lines: the
  * width correction w_r sqrt(1 + s^2) against the reference's 1/cos(atan s),
  * stripe coverage against the reference stripe test away from the edges,
- * 2 pi periodicity, and the mean cover when the stripes are finer than fw.
- * Exit 0 pass, 1 fail; needs an OpenGL 4.5 context (llvmpipe is fine).
+ * and the mean cover when the stripes are finer than fw.
+ * Stripe coverage is sampled over several windings of a, so 2 pi
+ * periodicity is part of it. Exit 0 pass, 1 fail; needs an OpenGL 4.5
+ * context (llvmpipe is fine).
  */
 #include <math.h>
 #include <stdio.h>
@@ -33,9 +35,12 @@ enum { CLASS_RANDOM, CLASS_NEAR, CLASS_AXIS, CLASS_INFINITY, CLASS_FAR, CLASS_IN
 static const char *const class_names[CLASS_COUNT] = {"random (1.01x-1e4x)", "near (1.001x-1.01x)", "on an axis",
                                                       "at infinity (c_z = 0)", "far (1e6x, 1e12x)",
                                                       "inside or on the ellipse"};
-/* Bounds on the eccentric-anomaly error (radians) and on |x^2/w^2 + y^2 - 1|. */
-static const double angle_bound[CLASS_COUNT] = {2e-3, 3e-2, 2e-3, 2e-3, 2e-3, 0};
-static const double on_bound[CLASS_COUNT] = {2e-3, 2e-2, 2e-3, 2e-3, 2e-3, 0};
+/* Bounds on the eccentric-anomaly error (radians) and on |x^2/w^2 + y^2 - 1|,
+ * about 25x what llvmpipe gave (measured: random 3.7e-6 rad / 6.4e-6; near
+ * 1.7e-4 / 2.6e-5 — float cancellation as the camera nears the conic; axis,
+ * infinity and far 1e-7 / 4e-7). */
+static const double angle_bound[CLASS_COUNT] = {1e-4, 5e-3, 1e-5, 1e-5, 1e-5, 0};
+static const double on_bound[CLASS_COUNT] = {2e-4, 1e-3, 1e-5, 1e-5, 1e-5, 0};
 
 typedef struct probe_case {
     float camera[4]; /* c.xyz, w */
@@ -201,9 +206,10 @@ int main(void)
         double on = fmax(fabs(p[0] * p[0] / (w * w) + p[1] * p[1] - 1.0), fabs(p[2] * p[2] / (w * w) + p[3] * p[3] - 1.0));
         if (!(e <= worst_angle[cls])) worst_angle[cls] = isnan(e) ? INFINITY : e;
         if (!(on <= worst_on[cls])) worst_on[cls] = isnan(on) ? INFINITY : on;
-        /* lambda at this camera's 8 points (random and random-axis cameras only: near the
+        /* lambda at this camera's 8 points, for the first 1000 random cameras and the
+         * axis ones (each reference lambda is a brute-force search of its own; near the
          * ellipse the chord is short and float lambda is ill-conditioned). */
-        if (cls != CLASS_RANDOM && cls != CLASS_AXIS)
+        if (!((cls == CLASS_RANDOM && k < 1000 * LAMBDA_POINTS) || cls == CLASS_AXIS))
             continue;
         for (int j = 0; j < LAMBDA_POINTS; j++) {
             const probe_case *q = &cases[k + j];
@@ -231,7 +237,8 @@ int main(void)
                      worst_on[k], on_bound[k]);
     }
     printf("lambda: max |gpu - reference| %.3g over %d points\n", worst_lambda, lambda_checked);
-    SL_CHECK_MSG(lambda_checked > 10000 && worst_lambda <= 2e-3, "lambda error %.3g over %d points", worst_lambda,
+    /* Measured 1.8e-5 (all 83200 points of every random and axis camera, once). */
+    SL_CHECK_MSG(lambda_checked > 5000 && worst_lambda <= 5e-4, "lambda error %.3g over %d points", worst_lambda,
                  lambda_checked);
 
     /* Twist lines. */
