@@ -2,7 +2,7 @@
  * per-pixel linked lists and per-pixel sorting, the transparency baseline of
  * Kanzler et al. (TVCG 2018, Sec. 5.3 and Table 2; lists after Yang et al.).
  *
- * prepare builds the swept tube mesh once (tubes_mesh_build.h, no caps, the
+ * prepare builds the swept tube mesh once (lines/sl_tube_mesh.h, no caps, the
  * front half of each tube is stored, so each tube crossing a pixel gives one
  * fragment). render: pass 1 rasterizes all tubes and appends every fragment
  * to its pixel's list in a node pool; pass 2 sorts each list by depth and
@@ -19,7 +19,8 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
-#include "../tubes_mesh/tubes_mesh_build.h"
+#include "../lines/sl_line_gpu.h"
+#include "../lines/sl_tube_mesh.h"
 
 #define NODE_BYTES 12u
 #define NIL 0x7fffffffu
@@ -43,11 +44,11 @@ static const sl_param_def lines_oit_params[] = {
 
 typedef struct lines_oit_state {
     const sl_dataset *dataset;  /* borrowed */
-    GLuint collect, resolve, vao, vbo, ibo, empty_vao, scalars, colormap_tex, camera_ubo;
+    GLuint collect, resolve, vao, vbo, ibo, empty_vao, camera_ubo;
+    sl_line_colors colors;      /* colormap texture + per-vertex colour scalars (SSBO 1) */
     GLuint heads_tex, counter_buf, nodes_buf;
     int heads_w, heads_h;
     size_t capacity;            /* nodes in nodes_buf */
-    int colormap_loaded, attribute_loaded;
     GLsizei index_count;
     size_t mesh_bytes, triangles;
     size_t last_fragments;      /* fragments of the last frame (stored or not) */
@@ -63,13 +64,13 @@ static void lines_oit_release(void *opaque)
     for (int i = 0; i < 2; i++)
         if (programs[i])
             glDeleteProgram(programs[i]);
-    GLuint bufs[6] = {s->vbo, s->ibo, s->scalars, s->camera_ubo, s->counter_buf, s->nodes_buf};
-    for (int i = 0; i < 6; i++)
+    GLuint bufs[5] = {s->vbo, s->ibo, s->camera_ubo, s->counter_buf, s->nodes_buf};
+    for (int i = 0; i < 5; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->empty_vao) glDeleteVertexArrays(1, &s->empty_vao);
-    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    sl_line_colors_deinit(&s->colors);
     if (s->heads_tex) glDeleteTextures(1, &s->heads_tex);
     free(s);
 }
@@ -83,8 +84,6 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
     s->dataset = ds;
-    s->colormap_loaded = -1;
-    s->attribute_loaded = -2;
     sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK) {
         free(s);
@@ -135,21 +134,19 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     glVertexArrayAttribIFormat(s->vao, 4, 1, GL_UNSIGNED_INT, offsetof(sl_tube_vertex, source));
     glVertexArrayAttribBinding(s->vao, 4, 0);
     glCreateVertexArrays(1, &s->empty_vao);
-    glCreateBuffers(1, &s->scalars);
-    glNamedBufferStorage(s->scalars, (GLsizeiptr)((ds->lines.vertex_count + 1) * sizeof(float)), NULL,
-                         GL_DYNAMIC_STORAGE_BIT);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
-    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glCreateBuffers(1, &s->counter_buf);
     glNamedBufferStorage(s->counter_buf, sizeof(GLuint), NULL, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
     s->index_count = (GLsizei)mesh.index_count;
     s->triangles = mesh.index_count / 3;
-    s->mesh_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t) +
-                    (ds->lines.vertex_count + 1) * sizeof(float);
+    s->mesh_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t);
     sl_tube_mesh_deinit(&mesh);
+    st = sl_line_colors_init(&s->colors, ds->lines.vertex_count, 1, "lines_oit", err);
+    if (st != SL_OK) {
+        lines_oit_release(s);
+        return st;
+    }
+    /* The scalars only: this technique has never counted its colormap texture. */
+    s->mesh_bytes += sl_line_colors_bytes(&s->colors) - SL_LINE_COLORS_TEXTURE_BYTES;
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     st = sl_gl_check_errors("lines_oit: uploading the mesh", err);
@@ -193,19 +190,12 @@ static void draw_lists(lines_oit_state *s, const sl_params *params, const sl_lin
     float opacity = (float)sl_params_float(params, "opacity");
     GLuint p = s->collect;
     glUseProgram(p);
-    glUniform1f(glGetUniformLocation(p, "u_radius"), style->radius);
+    sl_line_style_uniforms(p, style, 0);
     glUniform1ui(glGetUniformLocation(p, "u_capacity"), (GLuint)s->capacity);
-    glUniform2fv(glGetUniformLocation(p, "u_scalar_range"), 1, style->scalar_range);
-    glUniform1i(glGetUniformLocation(p, "u_use_colormap"), style->attribute >= 0);
-    glUniform3fv(glGetUniformLocation(p, "u_color"), 1, style->color);
-    glUniform3fv(glGetUniformLocation(p, "u_light_eye"), 1, style->light_direction);
-    glUniform4fv(glGetUniformLocation(p, "u_material"), 1, style->material);
     glUniform1f(glGetUniformLocation(p, "u_opacity"), opacity);
     glUniform1i(glGetUniformLocation(p, "u_opacity_ramp"),
                 style->attribute >= 0 && sl_params_choice(params, "opacity_transfer") == 1);
-    glUniform1i(glGetUniformLocation(p, "u_colormap"), 0);
-    glBindTextureUnit(0, s->colormap_tex);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->scalars);
+    sl_line_colors_bind(&s->colors, 0, 1);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->nodes_buf);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, s->counter_buf);
     glBindImageTexture(0, s->heads_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
@@ -252,18 +242,7 @@ static sl_status lines_oit_render(void *opaque, const sl_view *view, const sl_pa
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    if (style.colormap != s->colormap_loaded) {
-        uint8_t table[SL_COLORMAP_TEXELS * 4];
-        sl_colormap_table(style.colormap, table);
-        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
-        s->colormap_loaded = style.colormap;
-    }
-    if (style.attribute != s->attribute_loaded) {
-        if (style.attribute >= 0 && s->dataset->lines.vertex_count > 0)
-            glNamedBufferSubData(s->scalars, 0, (GLsizeiptr)(s->dataset->lines.vertex_count * sizeof(float)),
-                                 s->dataset->lines.attributes[style.attribute].values);
-        s->attribute_loaded = style.attribute;
-    }
+    sl_line_colors_update(&s->colors, &s->dataset->lines, &style);
     size_t cap_nodes = (size_t)(sl_params_float(params, "fragment_memory_mb") * 1024.0 * 1024.0 / NODE_BYTES);
     if (cap_nodes < 1)
         cap_nodes = 1;

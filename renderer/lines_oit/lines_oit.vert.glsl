@@ -1,4 +1,4 @@
-// lines_oit.vert.glsl — a vertex of the swept tube mesh (tubes_mesh_build.h):
+// lines_oit.vert.glsl — a vertex of the swept tube mesh (lines/sl_tube_mesh.h):
 // centre + unit offset * radius (the `radius` parameter for every tube).
 #include "gpu/glsl/camera.glsl"
 

@@ -20,6 +20,7 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
+#include "../lines/sl_line_gpu.h"
 #include "tubes_nodes.h"
 
 static const char *const root_methods[] = {"bisection", "illinois", "newton", NULL};
@@ -72,10 +73,9 @@ typedef struct tubes_state {
     GLuint nearest_tex;          /* r32ui, nearest_w x nearest_h: nearest hit depth bits per pixel */
     int nearest_w, nearest_h;
     double length_sum, length_radius_sum; /* sum of segment chords; of chord x mean data radius (occlusion auto) */
-    GLuint vao, node_vbo, color_vbo, ibo, colormap_tex, camera_ubo, query;
+    GLuint vao, node_vbo, color_vbo, ibo, camera_ubo, query;
+    sl_line_colors colors;       /* the colormap texture only: colour scalars live in color_vbo */
     GLuint empty_vao;            /* no attributes: the pulling and full-screen passes */
-    int colormap_loaded;         /* colormap index in colormap_tex, or -1 */
-    int attribute_loaded;        /* attribute in color_vbo, or -2 */
     size_t gpu_bytes;
     sl_prepare_stats prep;      /* node build (CPU) and upload times */
 } tubes_state;
@@ -97,7 +97,7 @@ static void tubes_release(void *opaque)
     if (s->node_vbo) glDeleteBuffers(1, &s->node_vbo);
     if (s->color_vbo) glDeleteBuffers(1, &s->color_vbo);
     if (s->ibo) glDeleteBuffers(1, &s->ibo);
-    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    sl_line_colors_deinit(&s->colors);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     if (s->query) glDeleteQueries(1, &s->query);
     sl_tubes_nodes_deinit(&s->nodes);
@@ -114,8 +114,6 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
     s->dataset = ds;
-    s->colormap_loaded = -1;
-    s->attribute_loaded = -2;
     sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK)
         goto fail;
@@ -174,18 +172,15 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
     glVertexArrayAttribBinding(s->vao, 0, 0);
     glVertexArrayAttribBinding(s->vao, 1, 0);
     glVertexArrayAttribBinding(s->vao, 2, 1);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
-    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    if ((st = sl_line_colors_init(&s->colors, s->nodes.node_count, 0, "tubes", err)) != SL_OK)
+        goto fail;
     glGenQueries(1, &s->query);
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     if ((st = sl_gl_check_errors("tubes: uploading nodes and segments", err)) != SL_OK)
         goto fail;
     s->gpu_bytes = nn * (SL_TUBES_NODE_FLOATS + 2) * sizeof(float) + ns * 2 * sizeof(uint32_t) +
-                   SL_COLORMAP_TEXELS * 4;
+                   sl_line_colors_bytes(&s->colors);
     /* The geometry lives on the GPU now; keep only the colour scalars. */
     free(s->nodes.geometry);
     s->nodes.geometry = NULL;
@@ -201,19 +196,12 @@ fail:
 static void set_uniforms(GLuint program, const sl_line_style *style, const sl_params *params, int data_radii)
 {
     glUseProgram(program);
-    glUniform1f(glGetUniformLocation(program, "u_radius"), style->radius);
-    glUniform1f(glGetUniformLocation(program, "u_radius_scale"), style->radius_scale);
+    sl_line_style_uniforms(program, style, 0);
     glUniform1i(glGetUniformLocation(program, "u_data_radii"), data_radii);
     glUniform1i(glGetUniformLocation(program, "u_frustum_cull"), sl_params_bool(params, "frustum_culling"));
     glUniform1f(glGetUniformLocation(program, "u_rect_pixels"), (float)sl_params_float(params, "small_box_pixels"));
     glUniform1i(glGetUniformLocation(program, "u_iterations"), sl_params_int(params, "iterations"));
     glUniform1i(glGetUniformLocation(program, "u_method"), sl_params_choice(params, "root_method"));
-    glUniform2fv(glGetUniformLocation(program, "u_scalar_range"), 1, style->scalar_range);
-    glUniform1i(glGetUniformLocation(program, "u_use_colormap"), style->attribute >= 0);
-    glUniform3fv(glGetUniformLocation(program, "u_color"), 1, style->color);
-    glUniform3fv(glGetUniformLocation(program, "u_light_eye"), 1, style->light_direction);
-    glUniform4fv(glGetUniformLocation(program, "u_material"), 1, style->material);
-    glUniform1i(glGetUniformLocation(program, "u_colormap"), 0);
 }
 
 /* (Re)creates the per-pixel nearest-hit image at the view's size. */
@@ -275,8 +263,7 @@ static sl_status render_with_prepass(tubes_state *s, const sl_view *view, const 
     glDisable(GL_MULTISAMPLE);
 
     glUseProgram(s->program_prepass);
-    glUniform1f(glGetUniformLocation(s->program_prepass, "u_radius"), style->radius);
-    glUniform1f(glGetUniformLocation(s->program_prepass, "u_radius_scale"), style->radius_scale);
+    sl_line_style_uniforms(s->program_prepass, style, 0);
     glUniform1i(glGetUniformLocation(s->program_prepass, "u_data_radii"), s->nodes.has_radii);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->node_vbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->ibo);
@@ -342,21 +329,14 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    if (style.colormap != s->colormap_loaded) {
-        uint8_t table[SL_COLORMAP_TEXELS * 4];
-        sl_colormap_table(style.colormap, table);
-        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
-        s->colormap_loaded = style.colormap;
-    }
-    if (style.attribute != s->attribute_loaded) {
+    if (sl_line_colors_update(&s->colors, &s->dataset->lines, &style)) {
         sl_tubes_nodes_set_color(&s->dataset->lines, style.attribute, &s->nodes);
         if (s->nodes.node_count)
             glNamedBufferSubData(s->color_vbo, 0, (GLsizeiptr)(s->nodes.node_count * 2 * sizeof(float)),
                                  s->nodes.color);
-        s->attribute_loaded = style.attribute;
     }
     sl_camera_ubo_update(&s->camera_ubo, view);
-    glBindTextureUnit(0, s->colormap_tex);
+    sl_line_colors_bind(&s->colors, 0, 0);
     stats->culled = 0.0;
     int silhouette_only = sl_params_bool(params, "silhouette_only");
     if (!silhouette_only && use_prepass(s, view, params, &style))

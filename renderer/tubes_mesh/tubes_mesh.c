@@ -2,7 +2,7 @@
  *
  * The tessellation baseline of the spline-tube (Russig et al.) and voxel-line
  * (Kanzler et al.) papers, and the first thing a user sees. prepare builds
- * the mesh on the CPU (tubes_mesh_build.c) and uploads it once; the radius
+ * the mesh on the CPU (lines/tube_mesh.c) and uploads it once; the radius
  * and every shading parameter are uniforms, so only `sides`, `caps` and
  * `radius_attribute` (per-vertex radii |value| from an attribute, baked into
  * the mesh like the data's own radii) re-prepare. One indexed draw per frame. `opacity` (shared by name with
@@ -11,7 +11,6 @@
  * order-dependent and only approximate where tubes overlap (lines_oit is the
  * sorted reference). Render thread only.
  */
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,7 +19,9 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
-#include "tubes_mesh_build.h"
+#include "../lines/sl_line_gpu.h"
+#include "../lines/sl_lines_prep.h"
+#include "../lines/sl_tube_mesh.h"
 
 static const sl_param_def tubes_mesh_params[] = {
     SL_LINE_STYLE_PARAMS,
@@ -34,10 +35,8 @@ static const sl_param_def tubes_mesh_params[] = {
 
 typedef struct tubes_mesh_state {
     const sl_dataset *dataset;  /* borrowed */
-    GLuint program, vao, vbo, ibo, colormap_tex, camera_ubo;
-    GLuint scalars;             /* SSBO: the chosen attribute's per-vertex values */
-    int colormap_loaded;        /* colormap index in colormap_tex, or -1 */
-    int attribute_loaded;       /* attribute index in `scalars`, or -2 */
+    GLuint program, vao, vbo, ibo, camera_ubo;
+    sl_line_colors colors;      /* colormap texture + the chosen attribute's per-vertex values (SSBO 1) */
     GLsizei index_count;
     size_t gpu_bytes;
     size_t triangles;
@@ -53,9 +52,8 @@ static void tubes_mesh_release(void *opaque)
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->vbo) glDeleteBuffers(1, &s->vbo);
     if (s->ibo) glDeleteBuffers(1, &s->ibo);
-    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
-    if (s->scalars) glDeleteBuffers(1, &s->scalars);
+    sl_line_colors_deinit(&s->colors);
     free(s);
 }
 
@@ -68,8 +66,6 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
     s->dataset = ds;
-    s->colormap_loaded = -1;
-    s->attribute_loaded = -2;
     sl_status st = sl_line_style_check(params, ds, err);
     if (st != SL_OK) {
         free(s);
@@ -86,9 +82,7 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
             free(s);
             return sl_err_set(err, SL_ERR_NOMEM, "tubes_mesh: out of memory for %zu radii", ds->lines.vertex_count);
         }
-        const float *v = ds->lines.attributes[style.radius_attribute].values;
-        for (size_t i = 0; i < ds->lines.vertex_count; i++)
-            attribute_radii[i] = isfinite(v[i]) ? fabsf(v[i]) : 0.0f;
+        sl_lines_attribute_radii(&ds->lines, style.radius_attribute, attribute_radii, 1);
         lines.radii = attribute_radii;
     }
     sl_tube_mesh mesh;
@@ -131,19 +125,16 @@ static sl_status tubes_mesh_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_
             glVertexArrayAttribFormat(s->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
         glVertexArrayAttribBinding(s->vao, a, 0);
     }
-    glCreateBuffers(1, &s->scalars);
-    glNamedBufferStorage(s->scalars, (GLsizeiptr)((ds->lines.vertex_count + 1) * sizeof(float)), NULL,
-                         GL_DYNAMIC_STORAGE_BIT);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
-    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     s->index_count = (GLsizei)mesh.index_count;
     s->triangles = mesh.index_count / 3;
-    s->gpu_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t) +
-                   (ds->lines.vertex_count + 1) * sizeof(float) + SL_COLORMAP_TEXELS * 4;
+    size_t mesh_bytes = mesh.vertex_count * sizeof(sl_tube_vertex) + mesh.index_count * sizeof(uint32_t);
     sl_tube_mesh_deinit(&mesh);
+    st = sl_line_colors_init(&s->colors, ds->lines.vertex_count, 1, "tubes_mesh", err);
+    if (st != SL_OK) {
+        tubes_mesh_release(s);
+        return st;
+    }
+    s->gpu_bytes = mesh_bytes + sl_line_colors_bytes(&s->colors);
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     st = sl_gl_check_errors("tubes_mesh: uploading the mesh", err);
@@ -165,30 +156,11 @@ static sl_status tubes_mesh_render(void *opaque, const sl_view *view, const sl_p
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    if (style.colormap != s->colormap_loaded) {
-        uint8_t table[SL_COLORMAP_TEXELS * 4];
-        sl_colormap_table(style.colormap, table);
-        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
-        s->colormap_loaded = style.colormap;
-    }
-    if (style.attribute != s->attribute_loaded) {
-        if (style.attribute >= 0 && s->dataset->lines.vertex_count > 0)
-            glNamedBufferSubData(s->scalars, 0, (GLsizeiptr)(s->dataset->lines.vertex_count * sizeof(float)),
-                                 s->dataset->lines.attributes[style.attribute].values);
-        s->attribute_loaded = style.attribute;
-    }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->scalars);
+    sl_line_colors_update(&s->colors, &s->dataset->lines, &style);
+    sl_line_colors_bind(&s->colors, 0, 1);
     sl_camera_ubo_update(&s->camera_ubo, view);
     glUseProgram(s->program);
-    glUniform1f(glGetUniformLocation(s->program, "u_radius"), style.radius);
-    glUniform1f(glGetUniformLocation(s->program, "u_radius_scale"), style.radius_scale);
-    glUniform2fv(glGetUniformLocation(s->program, "u_scalar_range"), 1, style.scalar_range);
-    glUniform1i(glGetUniformLocation(s->program, "u_use_colormap"), style.attribute >= 0);
-    glUniform3fv(glGetUniformLocation(s->program, "u_color"), 1, style.color);
-    glUniform3fv(glGetUniformLocation(s->program, "u_light_eye"), 1, style.light_direction);
-    glUniform4fv(glGetUniformLocation(s->program, "u_material"), 1, style.material);
-    glUniform1i(glGetUniformLocation(s->program, "u_colormap"), 0);
-    glBindTextureUnit(0, s->colormap_tex);
+    sl_line_style_uniforms(s->program, &style, 0);
     float opacity = (float)sl_params_float(params, "opacity");
     int blend = opacity < 1.0f;
     glUniform1f(glGetUniformLocation(s->program, "u_opacity"), opacity);

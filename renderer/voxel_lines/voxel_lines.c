@@ -32,6 +32,7 @@
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
+#include "../lines/sl_line_gpu.h"
 #include "voxel_gpu.h"
 #include "voxel_grid.h"
 #include "voxel_lines.h"
@@ -94,11 +95,11 @@ typedef struct voxel_lines_state {
     double build_ms;
     sl_prepare_stats prep;      /* timings of the last build_and_upload */
     size_t dropped_overflow, capped_voxels;
-    GLuint program, ao_program, density_program, vao, camera_ubo, colormap_tex;
+    GLuint program, ao_program, density_program, vao, camera_ubo;
+    sl_line_colors colors;      /* the colormap texture only (the attribute is baked into the grid) */
     GLuint offsets_buf, counts_buf, lines_buf, density_tex, ao_tex, occupancy_tex, reps_buf;
     int rep_levels, rep_dims[SL_VOXEL_LOD_MAX_LEVELS][3], rep_base[SL_VOXEL_LOD_MAX_LEVELS];
     int occupancy_levels;
-    int colormap_loaded;
     int ready;                  /* 1 when every grid buffer is uploaded */
     int ao_dims[3];
     int ao_valid;
@@ -136,7 +137,7 @@ static void voxel_lines_release(void *opaque)
     if (s->density_program) glDeleteProgram(s->density_program);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
-    if (s->colormap_tex) glDeleteTextures(1, &s->colormap_tex);
+    sl_line_colors_deinit(&s->colors);
     free(s);
 }
 
@@ -380,7 +381,6 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
     s->dataset = ds;
-    s->colormap_loaded = -1;
     s->quant = atoi(sl_params_choice_name(params, "quantization"));
     s->max_per_voxel = sl_params_int(params, "max_lines_per_voxel");
     s->resolution = sl_params_int(params, "grid");
@@ -419,12 +419,8 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
         return st;
     }
     glCreateVertexArrays(1, &s->vao);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->colormap_tex);
-    glTextureStorage2D(s->colormap_tex, 1, GL_RGBA8, SL_COLORMAP_TEXELS, 1);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(s->colormap_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    if ((st = sl_gl_check_errors("voxel_lines: uploading the voxel model", err)) != SL_OK) {
+    if ((st = sl_line_colors_init(&s->colors, ds->lines.vertex_count, 0, "voxel_lines", err)) != SL_OK ||
+        (st = sl_gl_check_errors("voxel_lines: uploading the voxel model", err)) != SL_OK) {
         voxel_lines_release(s);
         return st;
     }
@@ -532,12 +528,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
         if (st != SL_OK)
             return st;
     }
-    if (style.colormap != s->colormap_loaded) {
-        uint8_t table[SL_COLORMAP_TEXELS * 4];
-        sl_colormap_table(style.colormap, table);
-        glTextureSubImage2D(s->colormap_tex, 0, 0, 0, SL_COLORMAP_TEXELS, 1, GL_RGBA, GL_UNSIGNED_BYTE, table);
-        s->colormap_loaded = style.colormap;
-    }
+    sl_line_colors_update(&s->colors, &s->dataset->lines, &style);
     const double h = s->frame.h;
     float opacity = (float)sl_params_float(params, "opacity");
     float radius_g = (float)(style.radius / h);
@@ -583,13 +574,9 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     set1f(p, "u_alpha_stop", opacity >= 1.0f && !ramp ? 1.0f : (float)sl_params_float(params, "alpha_threshold"));
     set1i(p, "u_neighbors", neighbors);
     set1i(p, "u_opacity_by_distance", sl_params_bool(params, "opacity_by_distance"));
-    set1i(p, "u_use_colormap", style.attribute >= 0);
+    sl_line_style_uniforms(p, &style, 0);
     set1i(p, "u_opacity_ramp", ramp);
     glUniform2fv(glGetUniformLocation(p, "u_attr_range"), 1, attr_range);
-    glUniform3fv(glGetUniformLocation(p, "u_color"), 1, style.color);
-    glUniform3fv(glGetUniformLocation(p, "u_light_eye"), 1, style.light_direction);
-    glUniform4fv(glGetUniformLocation(p, "u_material"), 1, style.material);
-    set1i(p, "u_colormap", 0);
     set1i(p, "u_density", 1);
     set1i(p, "u_ao", 2);
     set1i(p, "u_occupancy", 3);
@@ -608,7 +595,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     set1i(p, "u_rep_base", s->rep_base[rep_level]);
     set1f(p, "u_rep_scale", (float)(1 << rep_level));
     set1f(p, "u_ao_strength", (float)sl_params_float(params, "ao_strength"));
-    glBindTextureUnit(0, s->colormap_tex);
+    sl_line_colors_bind(&s->colors, 0, 0);
     glBindTextureUnit(1, s->density_tex);
     glBindTextureUnit(2, s->ao_tex);
     glBindTextureUnit(3, s->occupancy_tex);

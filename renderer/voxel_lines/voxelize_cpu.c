@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "../core/sl_clock.h"
+#include "../lines/sl_lines_prep.h"
 
 /* --- Clipping ------------------------------------------------------------- */
 
@@ -190,28 +191,11 @@ sl_status sl_voxel_clip_polyline(const int dims[3], const double *points, const 
 
 /* --- Grid placement --------------------------------------------------------- */
 
-static void position_bounds(const sl_lines *l, double lo[3], double hi[3])
-{
-    for (int c = 0; c < 3; c++) {
-        lo[c] = DBL_MAX;
-        hi[c] = -DBL_MAX;
-    }
-    for (size_t v = 0; v < l->vertex_count; v++)
-        for (int c = 0; c < 3; c++) {
-            double x = l->positions[3 * v + c];
-            if (x < lo[c]) lo[c] = x;
-            if (x > hi[c]) hi[c] = x;
-        }
-    if (l->vertex_count == 0)
-        for (int c = 0; c < 3; c++)
-            lo[c] = hi[c] = 0.0;
-}
-
 int sl_voxel_auto_resolution(const sl_dataset *ds)
 {
     const sl_lines *l = &ds->lines;
     double lo[3], hi[3];
-    position_bounds(l, lo, hi);
+    sl_lines_position_bounds(l, lo, hi);
     double longest = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     double total = 0.0;
     size_t segments = 0;
@@ -242,7 +226,7 @@ sl_status sl_voxel_frame_init(sl_voxel_frame *f, const sl_dataset *ds, int resol
     if (resolution == 0)
         resolution = sl_voxel_auto_resolution(ds);
     double lo[3], hi[3];
-    position_bounds(&ds->lines, lo, hi);
+    sl_lines_position_bounds(&ds->lines, lo, hi);
     double longest = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(longest > 0.0))
         longest = 1.0;

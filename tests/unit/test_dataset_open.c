@@ -61,9 +61,9 @@ int main(void)
     char a[256], b[256], seg[PATH_MAX], outside[PATH_MAX], link[PATH_MAX];
     snprintf(a, sizeof a, "%s/a", root);
     snprintf(b, sizeof b, "%s/b", root);
-    snprintf(seg, sizeof seg, "%s/seg.json", b);
+    snprintf(seg, sizeof seg, "%s/b/seg.json", root); /* from root (known length), not b: gcc -Wformat-truncation */
     snprintf(outside, sizeof outside, "%s/outside.json", root);
-    snprintf(link, sizeof link, "%s/link.json", a);
+    snprintf(link, sizeof link, "%s/a/link.json", root);
     SL_CHECK(mkdir(a, 0700) == 0 && mkdir(b, 0700) == 0);
     write_text(seg, hermite);
     write_text(outside, hermite);

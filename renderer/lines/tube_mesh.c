@@ -1,36 +1,18 @@
-/* tubes_mesh_build.c — swept-circle tessellation of polylines (see tubes_mesh_build.h).
+/* tube_mesh.c — swept-circle tessellation of polylines (see sl_tube_mesh.h).
  *
- * Frames are propagated by parallel transport (the normal is projected off
- * each new tangent), so tubes do not twist. Tangents at inner vertices are
- * the normalized sum of the unit directions of both adjacent segments, which
- * stays defined for sharp turns short of a full reversal (then the incoming
- * direction is used). Counts are checked before anything is allocated:
- * indices must fit in 32 bits.
+ * Tangents and frames come from sl_lines_prep.h (bisector tangents,
+ * projection transport: tubes do not twist); this file places the rings,
+ * their triangles and the caps. Counts are checked before anything is
+ * allocated: indices must fit in 32 bits. Any thread; no GL.
  */
-#include "tubes_mesh_build.h"
+#include "sl_tube_mesh.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct v3f { float x, y, z; } v3f;
-
-static v3f vsub(v3f a, v3f b) { return (v3f){a.x - b.x, a.y - b.y, a.z - b.z}; }
-static v3f vadd(v3f a, v3f b) { return (v3f){a.x + b.x, a.y + b.y, a.z + b.z}; }
-static v3f vscale(v3f a, float s) { return (v3f){a.x * s, a.y * s, a.z * s}; }
-static float vdot(v3f a, v3f b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static v3f vcross(v3f a, v3f b) { return (v3f){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-static float vlen(v3f a) { return sqrtf(vdot(a, a)); }
-static v3f vnorm(v3f a) { float l = vlen(a); return l > 0.0f ? vscale(a, 1.0f / l) : (v3f){0, 0, 0}; }
-static v3f load(const float *p) { return (v3f){p[0], p[1], p[2]}; }
-static void store(float *o, v3f a) { o[0] = a.x; o[1] = a.y; o[2] = a.z; }
-
-/* Any unit vector orthogonal to the unit vector t. */
-static v3f any_orthogonal(v3f t)
-{
-    v3f axis = fabsf(t.x) < 0.6f ? (v3f){1, 0, 0} : (fabsf(t.y) < 0.6f ? (v3f){0, 1, 0} : (v3f){0, 0, 1});
-    return vnorm(vcross(t, axis));
-}
+#include "lines_v3f.h"
+#include "sl_lines_prep.h"
 
 void sl_tube_mesh_deinit(sl_tube_mesh *m)
 {
@@ -52,39 +34,31 @@ sl_status sl_tube_mesh_build(const sl_lines *lines, int sides, int caps,
     if (max_vertices >= UINT32_MAX || max_indices >= (size_t)1 << 31)
         return sl_err_set(err, SL_ERR_LIMIT, "tube mesh of %zu vertices and %zu indices is too large; lower 'sides'",
                           max_vertices, max_indices);
+    size_t nv = lines->vertex_count ? lines->vertex_count : 1;
     m->vertices = malloc((max_vertices ? max_vertices : 1) * sizeof *m->vertices);
     m->indices = malloc((max_indices ? max_indices : 1) * sizeof *m->indices);
-    size_t *kept = malloc((lines->vertex_count ? lines->vertex_count : 1) * sizeof *kept);
-    if (!m->vertices || !m->indices || !kept) {
+    size_t *kept = malloc(nv * sizeof *kept);
+    float *t3 = malloc(nv * 3 * sizeof *t3), *n3 = malloc(nv * 3 * sizeof *n3);
+    if (!m->vertices || !m->indices || !kept || !t3 || !n3) {
         free(kept);
+        free(t3);
+        free(n3);
         sl_tube_mesh_deinit(m);
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for a tube mesh of %zu vertices", max_vertices);
     }
+    sl_lines_tangents(lines, SL_LINES_TANGENT_BISECTOR, t3);
+    sl_lines_transport_normals(lines, t3, NULL, n3);
     const float cos_step = cosf(2.0f * (float)SL_PI / (float)sides), sin_step = sinf(2.0f * (float)SL_PI / (float)sides);
 
     for (size_t li = 0; li < lines->line_count; li++) {
-        size_t first = lines->line_offsets[li], end = lines->line_offsets[li + 1];
-        size_t n = 0;
-        for (size_t v = first; v < end; v++) {
-            if (n > 0 && vlen(vsub(load(&lines->positions[3 * v]), load(&lines->positions[3 * kept[n - 1]]))) == 0.0f)
-                continue; /* zero-length segment */
-            kept[n++] = v;
-        }
+        size_t n = sl_lines_kept(lines, li, kept);
         if (n < 2)
             continue;
         m->tube_count++;
-        v3f normal = {0, 0, 0};
         size_t ring0 = m->vertex_count;
         for (size_t k = 0; k < n; k++) {
             v3f p = load(&lines->positions[3 * kept[k]]);
-            v3f d_in = k > 0 ? vnorm(vsub(p, load(&lines->positions[3 * kept[k - 1]]))) : (v3f){0, 0, 0};
-            v3f d_out = k + 1 < n ? vnorm(vsub(load(&lines->positions[3 * kept[k + 1]]), p)) : (v3f){0, 0, 0};
-            v3f t = vnorm(vadd(d_in, d_out));
-            if (vlen(t) < 1e-6f)
-                t = k > 0 ? d_in : d_out;
-            normal = k == 0 ? any_orthogonal(t) : vnorm(vsub(normal, vscale(t, vdot(normal, t))));
-            if (vlen(normal) < 0.5f)
-                normal = any_orthogonal(t);
+            v3f t = load(&t3[3 * kept[k]]), normal = load(&n3[3 * kept[k]]);
             v3f binormal = vcross(t, normal);
             float radius = lines->radii ? lines->radii[kept[k]] : -1.0f;
             float c = 1.0f, s = 0.0f;
@@ -139,5 +113,7 @@ sl_status sl_tube_mesh_build(const sl_lines *lines, int sides, int caps,
         }
     }
     free(kept);
+    free(t3);
+    free(n3);
     return SL_OK;
 }
