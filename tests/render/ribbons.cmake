@@ -1,6 +1,6 @@
-# Tests of `ribbons` (renderer/ribbons/, issue 13) that exist so far: the halo
-# and twist-line shader functions on the GPU (ribbons_probe.comp.glsl) against
-# the CPU references of tests/support/ribbons_reference.h.
+# Tests of `ribbons` (renderer/ribbons/, issue 13). First the halo and
+# twist-line shader functions on the GPU (ribbons_probe.comp.glsl) against the
+# CPU references of tests/support/ribbons_reference.h, then the render tests.
 set(RIBBONS_DIR ${CMAKE_CURRENT_SOURCE_DIR}/ribbons)
 add_executable(test_ribbons_halo ${RIBBONS_DIR}/test_ribbons_halo.c)
 target_include_directories(test_ribbons_halo PRIVATE ${CMAKE_SOURCE_DIR}/tests/unit)
