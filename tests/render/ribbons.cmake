@@ -97,6 +97,13 @@ rb_test(accuracy.w1_vs_tubes_mesh ${CMAKE_COMMAND}
   "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/tube_oblique.json|--out|${RB_OUT}/w1_tm.png|--depth|${RB_OUT}/w1_tm.pfm|--set|technique=tubes_mesh|--set|params.sides=8"
   "-DSTEP3=${RB_DIFF}|${RB_OUT}/w1.pfm|${RB_OUT}/w1_tm.pfm|--bad-threshold|0.0152|--max-bad-pct|0.5|--max-coverage-pct|1"
   ${SL_STEPS})
+# The helix (150 segments: 3 chunks of <= 64) checks the chunk seams and
+# basevertex the same way: a wrong gl_VertexID base would tear the tube apart.
+rb_test(accuracy.w1_vs_tubes_mesh_chunks ${CMAKE_COMMAND}
+  "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/helix.json|--out|${RB_OUT}/w1h.png|--depth|${RB_OUT}/w1h.pfm|${RB_W1}|--set|params.radius=0.06|--set|params.twist_lines=0"
+  "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/helix.json|--out|${RB_OUT}/w1h_tm.png|--depth|${RB_OUT}/w1h_tm.pfm|--set|technique=tubes_mesh|--set|params={\"radius\":0.06,\"sides\":8,\"attribute\":1}"
+  "-DSTEP3=${RB_DIFF}|${RB_OUT}/w1h.pfm|${RB_OUT}/w1h_tm.pfm|--bad-threshold|0.0092|--max-bad-pct|0.5|--max-coverage-pct|1"
+  ${SL_STEPS})
 rb_test(accuracy.w1_detects_thin ${CMAKE_COMMAND}
   "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/tube_oblique.json|--out|${RB_OUT}/w07.png|--depth|${RB_OUT}/w07.pfm|${RB_W1}|--set|params.width_ratio=0.7"
   "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/tube_oblique.json|--out|${RB_OUT}/w07_tm.png|--depth|${RB_OUT}/w07_tm.pfm|--set|technique=tubes_mesh|--set|params.sides=8"
