@@ -144,3 +144,26 @@ rb_test(golden.detects_uniform_error ${CMAKE_COMMAND}
   "-DSTEP2=${RB_DIFF}|${RB_OUT}/golden_plus5.png|${RIBBONS_DIR}/golden/helix.png|${RB_GOLDEN_ARGS}"
   -DEXIT2=1 "-DOUT2=\"failed\":[ \t]*\\[\"max_mean\"\\]"
   ${SL_STEPS})
+
+# ---- halos (§3.2): red screen-space halos 2 px wide on a side-on ribbon
+# (--samples 1). Every silhouette end of every column has a red pixel within
+# 1 px and no red pixel is more than 4 px inside the outline. Twins: halo off
+# (no outline: fails the first half) and halo_width 40 px (red fills the
+# ribbon: fails the second half).
+function(rb_halo name expect_exit err)
+  string(REPLACE ";" "|" sets "${ARGN}")
+  if(sets)
+    set(sets "|${sets}")
+  endif()
+  set(extra)
+  if(NOT expect_exit EQUAL 0)
+    set(extra -DEXIT2=${expect_exit} "-DERR2=${err}")
+  endif()
+  rb_test(halo.${name} ${CMAKE_COMMAND}
+    "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/halo_side.json|--out|${RB_OUT}/halo_${name}.png|--samples|1${sets}"
+    "-DSTEP2=${RB_CHECK}|halo|--png|${RB_OUT}/halo_${name}.png|--max-dist|4"
+    ${extra} ${SL_STEPS})
+endfunction()
+rb_halo(on_silhouette 0 "")
+rb_halo(detects_off 1 "FAIL: column [0-9]+ has a silhouette end without halo" --set params.halo=false)
+rb_halo(detects_inside 1 "FAIL: [0-9]+ halo pixels inside the ribbon" --set params.halo_width=40)
