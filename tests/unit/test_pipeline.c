@@ -180,9 +180,13 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
     SL_CHECK_MSG(render(pipe, &view, 1, "same parameters again", t->name) == 0,
                  "%s: re-selecting it with the same parameters re-prepared", t->name);
 
-    int frame_level = 0, prepared_level = 0;
+    int frame_level = 0, prepared_level = 0, single_choice = 0;
     for (int i = 0; i < t->param_count; i++) {
         const sl_param_def *d = &t->params[i];
+        if (d->type == SL_PARAM_ENUM && d->choices[0] && !d->choices[1]) {
+            single_choice++; /* an enum of one choice (ribbons' pipeline today) has nothing to move to */
+            continue;
+        }
         if (!move_param(&params, i, &err)) {
             SL_CHECK_MSG(0, "%s: cannot move parameter '%s': %s", t->name, d->name, err.message);
             continue;
@@ -198,7 +202,8 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
         SL_CHECK_MSG(got == 0, "%s: after changing '%s', a camera move re-prepared", t->name, d->name);
         want ? prepared_level++ : frame_level++;
     }
-    printf("%s: %d parameters re-render only, %d re-prepare\n", t->name, frame_level, prepared_level);
+    printf("%s: %d parameters re-render only, %d re-prepare, %d of one choice\n", t->name, frame_level,
+           prepared_level, single_choice);
     SL_CHECK_MSG(frame_level > 0, "%s: no frame-level parameter was exercised", t->name);
 
     /* A new dataset re-prepares (and the old one is destroyed by the pipeline). */
