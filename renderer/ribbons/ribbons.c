@@ -11,7 +11,7 @@
  * halos (Sec. 3.2), twist lines (Sec. 4), the depth cue and the whole line
  * style are uniforms; per frame only the chunk culling and the multi-draw
  * arrays in client memory are rebuilt — no GL buffer is written on a camera
- * move. Render thread only. Plan: /work/ribbons_plan.md §1, §3.
+ * move. Render thread only. Plan: docs/ribbons_plan.md §1, §3.
  */
 #include <math.h>
 #include <stdlib.h>
