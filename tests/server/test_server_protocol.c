@@ -28,21 +28,6 @@
 #define H 96
 #define T 20000   /* generous per-step timeout (ASan + llvmpipe on 2 busy cores) */
 
-/* Fraction of pixels that differ from the top-left (background) pixel by more than 24 in any channel. */
-static double foreground_fraction(const sl_image *img)
-{
-    if (!img->rgba)
-        return 0;
-    size_t n = (size_t)img->width * (size_t)img->height, fg = 0;
-    const uint8_t *bg = img->rgba;
-    for (size_t i = 0; i < n; i++) {
-        const uint8_t *p = img->rgba + 4 * i;
-        if (abs(p[0] - bg[0]) > 24 || abs(p[1] - bg[1]) > 24 || abs(p[2] - bg[2]) > 24)
-            fg++;
-    }
-    return (double)fg / (double)n;
-}
-
 static int error_is(cJSON *j, const char *code, const char *field)
 {
     const cJSON *c = cJSON_GetObjectItemCaseSensitive(j, "code");
@@ -254,7 +239,7 @@ int main(void)
     SL_CHECK(a.last.h.state_version >= 1 && a.last.h.frame_id >= 1);
     sl_image first = tclient_decode_last(&a);
     SL_CHECK(first.width == W && first.height == H);
-    double fg = foreground_fraction(&first);
+    double fg = harness_foreground_fraction(&first);
     SL_CHECK_MSG(fg > 0.01 && fg < 0.95, "foreground fraction %.3f", fg);
 
     /* --- a camera change produces a different frame --- */
@@ -612,7 +597,7 @@ int main(void)
         sl_image png = {0};
         sl_err err;
         SL_CHECK(sl_png_read(path, &png, &err) == SL_OK && png.width == W && png.height == H);
-        SL_CHECK(foreground_fraction(&png) > 0.01);
+        SL_CHECK(harness_foreground_fraction(&png) > 0.01);
         double dj = harness_mean_diff(&png, &still_jpeg);
         SL_CHECK_MSG(dj >= 0 && dj < 4.0, "PNG snapshot vs still JPEG mean abs difference %.3f (bound 4)", dj);
         /* The same comparison against the JPEG flipped upside down must be clearly worse. */

@@ -23,20 +23,6 @@
 #define TF_A "[[0.3,0,0,0,0],[0.5,1,0.6,0.2,0.3],[0.7,0.2,0.5,1,0.6]]"
 #define TF_B "[[0.2,0,0,0,0],[0.6,0.2,1,0.2,0.8]]"
 
-static double foreground_fraction(const sl_image *img)
-{
-    if (!img->rgba)
-        return 0;
-    size_t n = (size_t)img->width * (size_t)img->height, fg = 0;
-    const uint8_t *bg = img->rgba;
-    for (size_t i = 0; i < n; i++) {
-        const uint8_t *p = img->rgba + 4 * i;
-        if (abs(p[0] - bg[0]) > 24 || abs(p[1] - bg[1]) > 24 || abs(p[2] - bg[2]) > 24)
-            fg++;
-    }
-    return (double)fg / (double)n;
-}
-
 /* Waits for a state patch whose `technique` is volume_dvr; returns its version (0 on timeout). */
 static uint32_t wait_technique(tclient *c)
 {
@@ -71,7 +57,7 @@ int main(void)
     SL_CHECK_MSG(v > 0, "no state patch switched to volume_dvr");
     SL_CHECK(v > 0 && tclient_wait_version(&a, v, T) == 0);
     sl_image first = tclient_decode_last(&a);
-    double fg = foreground_fraction(&first);
+    double fg = harness_foreground_fraction(&first);
     SL_CHECK_MSG(fg > 0.1 && fg < 0.9, "volume frame foreground fraction %.3f", fg);
 
     /* The same scene through sightline-render (camera: the session's default). */
@@ -153,7 +139,7 @@ int main(void)
     SL_CHECK_MSG(v3 > 0, "no state patch with the automatic opacity");
     SL_CHECK(v3 > 0 && tclient_wait_version(&a, v3, T) == 0);
     sl_image third = tclient_decode_last(&a);
-    double fg3 = foreground_fraction(&third);
+    double fg3 = harness_foreground_fraction(&third);
     printf("automatic opacity: foreground %.3f\n", fg3);
     SL_CHECK_MSG(fg3 > 0.1, "the automatic opacity shows almost nothing (foreground %.3f)", fg3);
 

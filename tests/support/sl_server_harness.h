@@ -421,6 +421,22 @@ static __attribute__((unused)) double harness_mean_diff(const sl_image *a, const
     return sum / (double)n;
 }
 
+/* Fraction of pixels that differ from the top-left (background) pixel by
+ * more than 24 in any channel; 0 for an empty image. */
+static __attribute__((unused)) double harness_foreground_fraction(const sl_image *img)
+{
+    if (!img->rgba)
+        return 0;
+    size_t n = (size_t)img->width * (size_t)img->height, fg = 0;
+    const uint8_t *bg = img->rgba;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *p = img->rgba + 4 * i;
+        if (abs(p[0] - bg[0]) > 24 || abs(p[1] - bg[1]) > 24 || abs(p[2] - bg[2]) > 24)
+            fg++;
+    }
+    return (double)fg / (double)n;
+}
+
 /* Renders scene_json (a scene document, proto/scene.md) with
  * $SIGHTLINE_BINARY_DIR/bin/sightline-render --samples 1 (the server
  * renders without MSAA) into h->dir/name.png and reads it back. Returns 0
