@@ -11,7 +11,8 @@ add_test(NAME unit.test_ribbons_halo COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_r
 set_tests_properties(unit.test_ribbons_halo PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
 
 # Render tests of the technique (plan §4.3): smoke, min_pixels edge-on, culling,
-# width_ratio 1 against tubes_mesh, stress scenes, a golden. Scenes and the
+# width_ratio 1 against tubes_mesh, stress scenes, goldens, halos (on the
+# silhouette; none with the camera inside), twist-line width. Scenes and the
 # small VTK files are in tests/render/ribbons/ (the VTK files were written once
 # by a few lines of Python: straight and receding edge-on ribbons with data
 # normals z, stress.vtk, a helix at the origin and at 1e5). The step runner is
@@ -138,6 +139,17 @@ rb_test(golden.helix ${CMAKE_COMMAND}
   "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/helix.json|--out|${RB_OUT}/golden_helix.png"
   "-DSTEP2=${RB_DIFF}|${RB_OUT}/golden_helix.png|${RIBBONS_DIR}/golden/helix.png|${RB_GOLDEN_ARGS}|--diff|${RB_OUT}/golden_helix_heat.png"
   ${SL_STEPS})
+# More goldens (plan §4.3): an S-curve ribbon lying in z = 0 seen edge-on (it
+# stays a band, min_thickness 0.15) and face-on, and a bifurcation (a trunk
+# and two branches leaving its end point; s_curve.vtk and bifurcation.vtk were
+# written by a few lines of Python). Regenerate as for the helix:
+#   sightline-render --scene tests/render/ribbons/golden_NAME.json --out tests/render/ribbons/golden/NAME.png
+foreach(name edge_on face_on bifurcation)
+  rb_test(golden.${name} ${CMAKE_COMMAND}
+    "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/golden_${name}.json|--out|${RB_OUT}/golden_${name}.png"
+    "-DSTEP2=${RB_DIFF}|${RB_OUT}/golden_${name}.png|${RIBBONS_DIR}/golden/${name}.png|${RB_GOLDEN_ARGS}|--diff|${RB_OUT}/golden_${name}_heat.png"
+    ${SL_STEPS})
+endforeach()
 # The limits catch +5 on every drawn pixel of that golden (covered mean 5 > 0.5).
 rb_test(golden.detects_uniform_error ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:golden-offset>|${RIBBONS_DIR}/golden/helix.png|${RB_OUT}/golden_plus5.png|26,26,31|5"
@@ -167,3 +179,47 @@ endfunction()
 rb_halo(on_silhouette 0 "")
 rb_halo(detects_off 1 "FAIL: column [0-9]+ has a silhouette end without halo" --set params.halo=false)
 rb_halo(detects_inside 1 "FAIL: [0-9]+ halo pixels inside the ribbon" --set params.halo_width=40)
+
+# ---- camera inside a ribbon's elliptic cylinder (plan §1.4): no silhouette,
+# so no halo at all. halo_inside.json puts the eye 0.145 from the axis of a
+# circular ribbon (r 0.15, 8 sides) across a facet's middle: outside the
+# octagon, so that facet is drawn (> 5 % of the frame), but inside the true
+# circle. Depth stays finite and in range. The twin 0.16 from the axis
+# (outside the circle) must show red halo pixels on the facet's edges.
+rb_test(halo.inside_no_halo ${CMAKE_COMMAND}
+  "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/halo_inside.json|--out|${RB_OUT}/halo_inside.png|--depth|${RB_OUT}/halo_inside.pfm|--samples|1"
+  "-DSTEP2=${RB_CHECK}|count|--png|${RB_OUT}/halo_inside.png|--min-covered-pct|5|--max-halo|0"
+  "-DSTEP3=${RB_IMAGE}|--scene|${RIBBONS_DIR}/halo_inside.json|--png|${RB_OUT}/halo_inside.png|--depth|${RB_OUT}/halo_inside.pfm|--min-color-pct|5|--min-hit-pct|5"
+  ${SL_STEPS})
+rb_test(halo.inside_detects_outside ${CMAKE_COMMAND}
+  "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/halo_inside.json|--out|${RB_OUT}/halo_outside.png|--samples|1|--set|camera.eye=[-0.9,-0.061229,0.147821]"
+  "-DSTEP2=${RB_CHECK}|count|--png|${RB_OUT}/halo_outside.png|--min-covered-pct|5|--max-halo|0"
+  -DEXIT2=1 "-DERR2=FAIL: [0-9]+ halo pixels, outside \\[0, 0\\]"
+  ${SL_STEPS})
+
+# ---- twist-line width correction (paper Eq. 6-7, plan §1.5): a straight
+# circular ribbon side-on (twist_width.json: r 0.4, eye 5 r from the axis,
+# helicity 1, 3 stripes of w_r 0.4 rad) with twist_scale f = tan(alpha) / (r h)
+# for stripe angles alpha = 0, 45 and 70 degrees to the axis. ribbons-check
+# twist_width maps each column back to angles on the circle and requires the
+# stripes' width across themselves, w_u cos(alpha), to be w_r within 5 %
+# (measured 0.393, 0.397, 0.397 for 0.4). Without the correction the stripes
+# would be w_r cos(alpha) across (0.137 at 70 degrees); the twin judges the
+# 70-degree image as if alpha were 0 and must fail.
+set(RB_TWIST_REF ${RB_RENDER}|--scene|${RIBBONS_DIR}/twist_width.json|--samples|1|--set|params.twist_lines=0|--out)
+set(RB_TWIST_CHECK ${RB_CHECK}|twist_width|--axis-distance|5|--fov-deg|45|--width|0.4|--span|0.8)
+foreach(case "0;0" "45;2.5" "70;6.8686935")
+  list(GET case 0 alpha)
+  list(GET case 1 scale)
+  rb_test(twist.width_${alpha} ${CMAKE_COMMAND}
+    "-DSTEP1=${RB_TWIST_REF}|${RB_OUT}/twist_ref_${alpha}.png"
+    "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/twist_width.json|--out|${RB_OUT}/twist_${alpha}.png|--samples|1|--set|params.twist_scale=${scale}"
+    "-DSTEP3=${RB_TWIST_CHECK}|--png|${RB_OUT}/twist_${alpha}.png|--reference|${RB_OUT}/twist_ref_${alpha}.png|--alpha-deg|${alpha}"
+    ${SL_STEPS})
+endforeach()
+rb_test(twist.detects_uncorrected ${CMAKE_COMMAND}
+  "-DSTEP1=${RB_TWIST_REF}|${RB_OUT}/twist_ref_70_as_0.png"
+  "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/twist_width.json|--out|${RB_OUT}/twist_70_as_0.png|--samples|1|--set|params.twist_scale=6.8686935"
+  "-DSTEP3=${RB_TWIST_CHECK}|--png|${RB_OUT}/twist_70_as_0.png|--reference|${RB_OUT}/twist_ref_70_as_0.png|--alpha-deg|0"
+  -DEXIT3=1 "-DERR3=FAIL: stripe width [0-9.]+, want 0.4000"
+  ${SL_STEPS})
