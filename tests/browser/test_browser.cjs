@@ -237,6 +237,29 @@ async function driveControls(page, obs, sess, saved) {
   check((await banner()) === '', `no error after the control changes (${await banner()})`);
   await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-controls.png') });
 
+  // ribbons through the page: a control for every parameter of its schema;
+  // its own enum (halo_space) and int (twist_lines) reach the server, and
+  // its frame arrives without an error.
+  await page.selectOption('#technique', 'ribbons');
+  st = await serverStateWhere(obs, sess, (s) => s.technique === 'ribbons', 'technique ribbons');
+  check(st, 'technique ribbons on the server');
+  await page.waitForFunction(() => window.sightline.state.technique === 'ribbons', null, { timeout: T });
+  schema = await schemaOf('ribbons');
+  const ribbonControls = await page.$$eval('#params label.param span.name', (xs) => xs.map((x) => x.textContent));
+  check(same(ribbonControls, schema.map((d) => d.name)),
+    `controls follow the ribbons schema (${ribbonControls.length} of ${schema.length})`);
+  await page.selectOption('#params select[name=halo_space]', 'screen');
+  check(await serverStateWhere(obs, sess, (s) => s.params.halo_space === 'screen', 'halo_space'),
+    'ribbons halo_space = screen on the server');
+  await page.focus('#params input[type=range][name=twist_lines]');
+  await page.keyboard.press('Home');
+  for (let k = 0; k < 3; k++) await page.keyboard.press('ArrowRight');
+  check(await serverStateWhere(obs, sess, (s) => s.params.twist_lines === 3, 'twist_lines'),
+    'ribbons twist_lines = 3 on the server');
+  await settled(page);
+  check((await banner()) === '', `no error on ribbons (${await banner()})`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-ribbons.png') });
+
   // Technique picker: the server switches, the controls follow the new schema.
   const tech = 'tubes';
   await page.selectOption('#technique', tech);
