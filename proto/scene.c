@@ -162,13 +162,14 @@ void sl_scene_deinit(sl_scene *s)
 {
     cJSON_Delete(s->dataset);
     cJSON_Delete(s->params);
+    sl_scene_path_destroy(s->path);
     memset(s, 0, sizeof *s);
 }
 
 sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
 {
     static const char *const scene_keys[] = {"dataset", "technique", "params", "camera", "width", "height",
-                                             "background", "orbit_frames", "description", NULL};
+                                             "background", "orbit_frames", "path", "description", NULL};
     memset(s, 0, sizeof *s);
     snprintf(s->technique, sizeof s->technique, "tubes_mesh");
     s->camera = sl_camera_spec_default();
@@ -253,6 +254,18 @@ sl_status sl_scene_from_json(const cJSON *root, sl_scene *s, sl_err *err)
         sl_err_prefix(err, "params");
         sl_scene_deinit(s);
         return st;
+    }
+    const cJSON *path = cJSON_GetObjectItemCaseSensitive(root, "path");
+    if (path) {
+        if (cam || s->orbit_frames > 0) {
+            sl_scene_deinit(s);
+            return sl_err_set(err, SL_ERR_INVALID, "path: its keyframes give every frame's camera, so the scene "
+                                                   "must not have %s too", cam ? "a camera" : "orbit_frames");
+        }
+        if ((st = sl_scene_path_parse(path, tech, &s->path, err)) != SL_OK) {
+            sl_scene_deinit(s);
+            return st;
+        }
     }
     return SL_OK;
 }
@@ -359,7 +372,13 @@ sl_status sl_scene_view(const sl_scene *s, const sl_dataset *ds, int frame, sl_v
     sl_camera_spec cam = s->camera;
     if (cam.is_orbit && s->orbit_frames > 0)
         cam.orbit.azimuth_deg += 360.0 * (double)frame / (double)s->orbit_frames;
-    sl_status st = sl_camera_spec_resolve(&cam, ds->bounds_min, ds->bounds_max, &view->camera, err);
+    sl_status st = SL_OK;
+    if (s->path)
+        st = sl_camera_path_at(s->path->keys, s->path->key_count, s->path->interpolation, frame / s->path->fps,
+                               ds->bounds_min, ds->bounds_max, &cam, err);
+    if (st != SL_OK)
+        return st;
+    st = sl_camera_spec_resolve(&cam, ds->bounds_min, ds->bounds_max, &view->camera, err);
     if (st != SL_OK)
         return st;
     return sl_view_init(view, sl_dataset_radius(ds), err);

@@ -12,6 +12,7 @@
 #include <cjson/cJSON.h>
 
 #include "core/sl_camera.h"
+#include "sl_scene_path.h"
 #include "core/sl_params.h"
 #include "core/sl_technique.h"
 #include "data/sl_dataset.h"
@@ -26,6 +27,7 @@ typedef struct sl_scene {
     int width, height;
     float background[4];
     int orbit_frames;          /* 0: every frame uses the camera as given */
+    sl_scene_path *path;       /* owned; NULL: no camera path (sl_scene_path.h) */
 } sl_scene;
 
 /* Parses a scene document. Defaults: technique "tubes_mesh", the camera
@@ -55,7 +57,8 @@ sl_status sl_camera_json_parse(const cJSON *obj, sl_camera_spec *out, sl_err *er
 cJSON *sl_camera_to_json(const sl_camera_spec *spec);
 
 /* The view of frame `frame` (orbit_frames advance the azimuth by
- * 360/orbit_frames per frame) for a dataset's bounds. */
+ * 360/orbit_frames per frame; a path gives the camera at t = frame / fps)
+ * for a dataset's bounds. */
 sl_status sl_scene_view(const sl_scene *scene, const sl_dataset *ds, int frame, sl_view *view, sl_err *err);
 
 #endif

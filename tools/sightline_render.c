@@ -3,6 +3,10 @@
  * usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm]
  *          [--frames N] [--stats stats.json] [--set key.path=value ...]
  *          [--samples N] [--data-dir DIR]
+ *        sightline-render --path P.json --out frames/%05d.png [--stats ...] [--set ...]
+ * A scene with a `path` (proto/scene.md "Paths") renders every frame of it,
+ * frame k at t = k / fps, to the --out pattern (one %d or %0Nd); --path is
+ * --scene that also requires the path.
  * A thin main over the renderer library: scene -> dataset -> pipeline. The
  * colour frame uses --samples MSAA (default 4); the depth map is rendered
  * without MSAA so every pixel is the exact centre ray of sl_camera.h.
@@ -44,14 +48,17 @@
 
 typedef struct options {
     const char *scene, *out, *depth, *stats, *data_dir;
+    int require_path;           /* --path given */
     const char *sets[MAX_SETS];
-    int set_count, frames, samples;
+    int set_count, frames, samples, frames_given;
 } options;
 
 static void print_usage(FILE *f)
 {
     fprintf(f, "usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm] [--frames N]\n"
                "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR]\n"
+               "       sightline-render --path P.json --out frames/%%05d.png [--stats ...] [--set ...] [--samples N]\n"
+               "  --path     a scene with a \"path\": every frame of it to the --out pattern (one %%d or %%0Nd)\n"
                "  --out      .png, or .jpg/.jpeg for JPEG     --depth  .pfm (eye distance, 0 = no hit)\n"
                "  --stats    .json                            --frames N in [1, 100000] (default 1)\n"
                "  --samples  MSAA samples in [0, 16] (default 4; 0 or 1 = none; at most what the GPU offers)\n"
@@ -100,7 +107,7 @@ static int parse_args(int argc, char **argv, options *o)
         }
         if (strncmp(a, "--", 2) != 0)
             return usage("unexpected argument '%s' (every value follows its option, e.g. --scene S.json)", a);
-        static const char *const known[] = {"--scene", "--out", "--depth", "--stats", "--data-dir",
+        static const char *const known[] = {"--scene", "--path", "--out", "--depth", "--stats", "--data-dir",
                                             "--frames", "--samples", "--set", NULL};
         int k = 0;
         while (known[k] && strcmp(a, known[k]) != 0)
@@ -110,7 +117,12 @@ static int parse_args(int argc, char **argv, options *o)
         if (i + 1 >= argc)
             return usage("%s needs a value", a);
         const char *v = argv[++i];
-        if (strcmp(a, "--scene") == 0) o->scene = v;
+        if (strcmp(a, "--scene") == 0 || strcmp(a, "--path") == 0) {
+            if (o->scene)
+                return usage("give one of --scene or --path, once");
+            o->scene = v;
+            o->require_path = strcmp(a, "--path") == 0;
+        }
         else if (strcmp(a, "--out") == 0) o->out = v;
         else if (strcmp(a, "--depth") == 0) o->depth = v;
         else if (strcmp(a, "--stats") == 0) o->stats = v;
@@ -118,6 +130,7 @@ static int parse_args(int argc, char **argv, options *o)
         else if (strcmp(a, "--frames") == 0) {
             if (!parse_int(v, 1, 100000, &o->frames))
                 return usage("--frames must be an integer in [1, 100000], got '%s'", v);
+            o->frames_given = 1;
         } else if (strcmp(a, "--samples") == 0) {
             if (!parse_int(v, 0, 16, &o->samples))
                 return usage("--samples must be an integer in [0, 16], got '%s'", v);
@@ -128,7 +141,7 @@ static int parse_args(int argc, char **argv, options *o)
         }
     }
     if (!o->scene || !o->out)
-        return usage("--scene and --out are required");
+        return usage("--scene (or --path) and --out are required");
     return 0;
 }
 
@@ -326,6 +339,76 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
     return ok;
 }
 
+/* 1 when pattern has exactly one frame-number conversion, %d or %0Nd
+ * (N in 1..9), and no other '%' except "%%". */
+static int frame_pattern_ok(const char *pattern)
+{
+    int conversions = 0;
+    for (const char *c = pattern; *c; c++) {
+        if (*c != '%')
+            continue;
+        if (c[1] == '%') {
+            c++;
+            continue;
+        }
+        const char *d = c + 1;
+        if (*d == '0' && d[1] >= '1' && d[1] <= '9')
+            d += 2;
+        if (*d != 'd')
+            return 0;
+        conversions++;
+        c = d;
+    }
+    return conversions == 1;
+}
+
+/* The path's checks on the options, once the scene is read: prints the reason and returns 0 when they fail. */
+static int check_path_options(options *o, const sl_scene *scene, const sl_technique *tech)
+{
+    if (!scene->path) {
+        if (o->require_path)
+            fprintf(stderr, "sightline-render: --path %s: the scene has no \"path\" (proto/scene.md, Paths)\n",
+                    o->scene);
+        return !o->require_path;
+    }
+    if (o->frames_given || o->depth) {
+        fprintf(stderr, "sightline-render: %s: a scene with a path renders its own frames; --%s does not apply\n",
+                o->scene, o->frames_given ? "frames" : "depth (not written for paths)");
+        return 0;
+    }
+    if (!frame_pattern_ok(o->out)) {
+        fprintf(stderr, "sightline-render: --out %s: a path needs a file name pattern with one %%d or %%0Nd for the "
+                        "frame number, e.g. frames/%%05d.png\n", o->out);
+        return 0;
+    }
+    o->frames = sl_scene_path_frames(scene->path);
+    char costly[256];
+    if (sl_scene_path_prepared_params(scene->path, tech, costly, sizeof costly) > 0)
+        fprintf(stderr, "sightline-render: note: the path changes %s, which re-prepares %s on every frame it changes "
+                        "(costly)\n", costly, tech->name);
+    return 1;
+}
+
+/* The technique's params at frame f of the scene's path (or its plain params without one). */
+static sl_status frame_params(const sl_scene *scene, const sl_technique *tech, int f, sl_params *params, sl_err *err)
+{
+    sl_params_init(params, tech->params, tech->param_count);
+    if (!scene->path)
+        return sl_params_apply_json(params, scene->params, err); /* validated by sl_scene_from_json */
+    cJSON *at = sl_scene_path_params(scene->path, f / scene->path->fps, scene->params, tech);
+    if (!at)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    sl_status st = sl_params_apply_json(params, at, err);
+    cJSON_Delete(at);
+    return st;
+}
+
+static sl_status write_image(const char *path, const uint8_t *rgba, int width, int height, sl_err *err)
+{
+    return ends_with(path, ".jpg") || ends_with(path, ".jpeg") ? sl_jpeg_write(path, rgba, width, height, 92, err)
+                                                               : sl_png_write(path, rgba, width, height, err);
+}
+
 int main(int argc, char **argv)
 {
     options o;
@@ -337,6 +420,11 @@ int main(int argc, char **argv)
     sl_scene scene;
     if (!load_scene(&o, &scene))
         return EXIT_BAD_INPUT;
+    const sl_technique *tech = sl_technique_find(scene.technique);
+    if (!check_path_options(&o, &scene, tech)) {
+        sl_scene_deinit(&scene);
+        return EXIT_USAGE;
+    }
 
     /* The GPU and its limits first: cheap, and a failure there should not
      * wait for a dataset load. */
@@ -367,10 +455,7 @@ int main(int argc, char **argv)
     }
     double load_ms = sl_clock_ms() - t0;
 
-    const sl_technique *tech = sl_technique_find(scene.technique);
     sl_params params;
-    sl_params_init(&params, tech->params, tech->param_count);
-    sl_params_apply_json(&params, scene.params, &err); /* validated by sl_scene_from_json */
 
     sl_pipeline *pipe = NULL;
     int exit_code = EXIT_OK;
@@ -387,13 +472,19 @@ int main(int argc, char **argv)
     }
     sl_pipeline_set_dataset(pipe, ds);
     ds = NULL; /* owned by the pipeline now */
-    if ((st = sl_pipeline_set_technique(pipe, tech, &params, &err)) != SL_OK) {
-        fprintf(stderr, "sightline-render: %s\n", err.message);
-        exit_code = exit_for(st);
-        goto done;
-    }
+    int progress = scene.path && isatty(STDERR_FILENO);
+    double t_start = sl_clock_ms();
     for (int f = 0; f < o.frames; f++) {
         sl_frame_stats stats;
+        if (f == 0 || scene.path) {
+            if ((st = frame_params(&scene, tech, f, &params, &err)) == SL_OK)
+                st = sl_pipeline_set_technique(pipe, tech, &params, &err);
+            if (st != SL_OK) {
+                fprintf(stderr, "sightline-render: frame %d: %s\n", f, err.message);
+                exit_code = exit_for(st);
+                goto done;
+            }
+        }
         if ((st = sl_scene_view(&scene, sl_pipeline_dataset(pipe), f, &view, &err)) != SL_OK ||
             (st = sl_pipeline_render(pipe, &view, o.samples, &stats, &err)) != SL_OK) {
             fprintf(stderr, "sightline-render: frame %d: %s\n", f, err.message);
@@ -405,15 +496,31 @@ int main(int argc, char **argv)
         last = stats;
         gpu_ms[f] = stats.gpu_ms;
         wall_ms[f] = stats.wall_ms;
+        if (scene.path) { /* every frame of a path is a file */
+            char name[4096];
+            snprintf(name, sizeof name, o.out, f);
+            sl_pipeline_read_rgba(pipe, rgba, 1);
+            if ((st = write_image(name, rgba, scene.width, scene.height, &err)) != SL_OK) {
+                fprintf(stderr, "%ssightline-render: %s\n", progress ? "\n" : "", err.message);
+                exit_code = EXIT_BAD_INPUT;
+                goto done;
+            }
+            if (progress) {
+                double spent = (sl_clock_ms() - t_start) / 1000.0;
+                fprintf(stderr, "\rsightline-render: frame %d of %d, %.1f s, about %.0f s left   ", f + 1, o.frames,
+                        spent, spent / (f + 1) * (o.frames - f - 1));
+            }
+        }
     }
-    sl_pipeline_read_rgba(pipe, rgba, 1);
-    st = ends_with(o.out, ".jpg") || ends_with(o.out, ".jpeg")
-             ? sl_jpeg_write(o.out, rgba, scene.width, scene.height, 92, &err)
-             : sl_png_write(o.out, rgba, scene.width, scene.height, &err);
-    if (st != SL_OK) {
-        fprintf(stderr, "sightline-render: %s\n", err.message);
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+    if (progress)
+        fputc('\n', stderr);
+    if (!scene.path) {
+        sl_pipeline_read_rgba(pipe, rgba, 1);
+        if ((st = write_image(o.out, rgba, scene.width, scene.height, &err)) != SL_OK) {
+            fprintf(stderr, "sightline-render: %s\n", err.message);
+            exit_code = EXIT_BAD_INPUT;
+            goto done;
+        }
     }
     if (o.depth) {
         sl_frame_stats stats;
@@ -433,8 +540,13 @@ int main(int argc, char **argv)
         exit_code = EXIT_BAD_INPUT;
         goto done;
     }
-    printf("wrote %s (%dx%d, %s, %d frame%s)\n", o.out, scene.width, scene.height, tech->name, o.frames,
-           o.frames == 1 ? "" : "s");
+    if (scene.path)
+        printf("wrote %d frames %s (%dx%d, %s, %.2f s of path at %g fps) in %.1f s\n", o.frames, o.out, scene.width,
+               scene.height, tech->name, (o.frames - 1) / scene.path->fps, scene.path->fps,
+               (sl_clock_ms() - t_start) / 1000.0);
+    else
+        printf("wrote %s (%dx%d, %s, %d frame%s)\n", o.out, scene.width, scene.height, tech->name, o.frames,
+               o.frames == 1 ? "" : "s");
 done:
     free(gpu_ms);
     free(wall_ms);

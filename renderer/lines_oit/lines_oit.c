@@ -145,8 +145,7 @@ static sl_status lines_oit_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         lines_oit_release(s);
         return st;
     }
-    /* The scalars only: this technique has never counted its colormap texture. */
-    s->mesh_bytes += sl_line_colors_bytes(&s->colors) - SL_LINE_COLORS_TEXTURE_BYTES;
+    s->mesh_bytes += sl_line_colors_bytes(&s->colors); /* colour scalars and the colormap texture */
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     st = sl_gl_check_errors("lines_oit: uploading the mesh", err);

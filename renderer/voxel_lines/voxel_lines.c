@@ -627,7 +627,7 @@ static void voxel_lines_prepare_stats(const void *opaque, sl_prepare_stats *out)
 static size_t voxel_lines_gpu_bytes(const void *opaque)
 {
     const voxel_lines_state *s = opaque;
-    return s ? s->grid_bytes : 0;
+    return s ? s->grid_bytes + sl_line_colors_bytes(&s->colors) : 0;
 }
 
 const sl_technique sl_voxel_lines_technique = {

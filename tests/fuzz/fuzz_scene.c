@@ -11,7 +11,10 @@
  * 0..1, a valid camera or orbit, orbit_frames only on an orbit; its view of
  * a stand-in dataset (bounds only, never loaded: sl_scene_open_dataset reads
  * files and is not driven here) is either SL_OK with finite matrices or an
- * error with a message. A failure leaves the scene owning nothing and says why.
+ * error with a message. A path has 1 .. SL_PATH_MAX_FRAMES frames, strictly
+ * ascending key times, and its parameters at the first, a middle and the
+ * last frame are valid for the technique's schema (interpolated values stay
+ * in range). A failure leaves the scene owning nothing and says why.
  * Violations abort(). Seed corpus: tests/fuzz/corpus/scene/. Single-threaded.
  */
 #include <math.h>
@@ -27,7 +30,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 /* Deinitialized: owns no JSON (sl_scene_deinit on it would free nothing). */
 static int owns_nothing(const sl_scene *s)
 {
-    return s->dataset == NULL && s->params == NULL;
+    return s->dataset == NULL && s->params == NULL && s->path == NULL;
 }
 
 static void check_scene(sl_status st, sl_scene *s, const sl_err *err)
@@ -67,6 +70,26 @@ static void check_scene(sl_status st, sl_scene *s, const sl_err *err)
         abort();
     }
 
+    int frames = 2;
+    if (s->path) {
+        frames = sl_scene_path_frames(s->path);
+        if (frames < 1 || frames > SL_PATH_MAX_FRAMES || s->path->key_count < 1)
+            abort();
+        for (int k = 1; k < s->path->key_count; k++)
+            if (!(s->path->keys[k].t > s->path->keys[k - 1].t))
+                abort();
+        const int probe[3] = {0, frames / 2, frames - 1};
+        for (int i = 0; i < 3; i++) {
+            cJSON *at = sl_scene_path_params(s->path, probe[i] / s->path->fps, s->params, tech);
+            sl_params q;
+            sl_params_init(&q, tech->params, tech->param_count);
+            sl_err qerr = {0};
+            if (at && sl_params_apply_json(&q, at, &qerr) != SL_OK)
+                abort();
+            cJSON_Delete(at);
+        }
+    }
+
     /* The view of a stand-in dataset: bounds only (no lines are read). */
     sl_dataset ds;
     memset(&ds, 0, sizeof ds);
@@ -74,7 +97,8 @@ static void check_scene(sl_status st, sl_scene *s, const sl_err *err)
     ds.origin = sl_v3(0.5, -2.0, 3.0);
     ds.bounds_min = sl_v3(-0.5, -3.0, 2.0);
     ds.bounds_max = sl_v3(1.5, -1.0, 4.5);
-    for (int frame = 0; frame < 2; frame++) {
+    for (int f = 0; f < 3; f++) {
+        int frame = f == 2 ? frames - 1 : f;
         sl_view view;
         sl_err verr = {0};
         sl_status vs = sl_scene_view(s, &ds, frame, &view, &verr);
