@@ -3,10 +3,13 @@
  * usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm]
  *          [--frames N] [--stats stats.json] [--set key.path=value ...]
  *          [--samples N] [--data-dir DIR]
- *        sightline-render --path P.json --out frames/%05d.png [--stats ...] [--set ...]
+ *        sightline-render --path P.json [--out frames/%05d.png] [--video V.mp4|.webm]
+ *          [--crf N] [--stats ...] [--set ...]
  * A scene with a `path` (proto/scene.md "Paths") renders every frame of it,
- * frame k at t = k / fps, to the --out pattern (one %d or %0Nd); --path is
- * --scene that also requires the path.
+ * frame k at t = k / fps, to the --out pattern (one %d or %0Nd) and/or into
+ * a video (image/sl_video.h: .mp4 H.264, .webm VP9, constant quality --crf);
+ * --path is --scene that also requires the path. --video without a path
+ * records the --frames N frames (e.g. an orbit_frames turntable) at 24 fps.
  * A thin main over the renderer library: scene -> dataset -> pipeline. The
  * colour frame uses --samples MSAA (default 4); the depth map is rendered
  * without MSAA so every pixel is the exact centre ray of sl_camera.h.
@@ -35,11 +38,13 @@
 #include "core/sl_clock.h"
 #include "data/sl_load.h"
 #include "image/sl_image.h"
+#include "image/sl_video.h"
 #include "pipeline/sl_pipeline.h"
 #include "sl_params_json.h"
 #include "sl_scene.h"
 
 #define MAX_SETS 64
+#define SL_RENDER_VIDEO_FPS 24.0 /* --video without a path */
 
 #define EXIT_OK 0
 #define EXIT_USAGE 1
@@ -47,8 +52,9 @@
 #define EXIT_GPU 3
 
 typedef struct options {
-    const char *scene, *out, *depth, *stats, *data_dir;
+    const char *scene, *out, *depth, *stats, *data_dir, *video;
     int require_path;           /* --path given */
+    int crf;                    /* -1: the codec's default */
     const char *sets[MAX_SETS];
     int set_count, frames, samples, frames_given;
 } options;
@@ -57,8 +63,10 @@ static void print_usage(FILE *f)
 {
     fprintf(f, "usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm] [--frames N]\n"
                "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR]\n"
-               "       sightline-render --path P.json --out frames/%%05d.png [--stats ...] [--set ...] [--samples N]\n"
+               "       sightline-render --path P.json [--out frames/%%05d.png] [--video V.mp4] [--crf N] [--stats ...]\n"
                "  --path     a scene with a \"path\": every frame of it to the --out pattern (one %%d or %%0Nd)\n"
+               "  --video    .mp4 (H.264, CRF 18 by default) or .webm (VP9, CRF 24): every frame, at the path's\n"
+               "             fps (24 without a path); even width and height   --crf N  constant quality\n"
                "  --out      .png, or .jpg/.jpeg for JPEG     --depth  .pfm (eye distance, 0 = no hit)\n"
                "  --stats    .json                            --frames N in [1, 100000] (default 1)\n"
                "  --samples  MSAA samples in [0, 16] (default 4; 0 or 1 = none; at most what the GPU offers)\n"
@@ -98,6 +106,7 @@ static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->frames = 1;
+    o->crf = -1;
     o->samples = 4;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -108,7 +117,7 @@ static int parse_args(int argc, char **argv, options *o)
         if (strncmp(a, "--", 2) != 0)
             return usage("unexpected argument '%s' (every value follows its option, e.g. --scene S.json)", a);
         static const char *const known[] = {"--scene", "--path", "--out", "--depth", "--stats", "--data-dir",
-                                            "--frames", "--samples", "--set", NULL};
+                                            "--frames", "--samples", "--set", "--video", "--crf", NULL};
         int k = 0;
         while (known[k] && strcmp(a, known[k]) != 0)
             k++;
@@ -124,6 +133,11 @@ static int parse_args(int argc, char **argv, options *o)
             o->require_path = strcmp(a, "--path") == 0;
         }
         else if (strcmp(a, "--out") == 0) o->out = v;
+        else if (strcmp(a, "--video") == 0) o->video = v;
+        else if (strcmp(a, "--crf") == 0) {
+            if (!parse_int(v, 0, 63, &o->crf))
+                return usage("--crf must be an integer in [0, 63], got '%s'", v);
+        }
         else if (strcmp(a, "--depth") == 0) o->depth = v;
         else if (strcmp(a, "--stats") == 0) o->stats = v;
         else if (strcmp(a, "--data-dir") == 0) o->data_dir = v;
@@ -140,8 +154,10 @@ static int parse_args(int argc, char **argv, options *o)
             o->sets[o->set_count++] = v;
         }
     }
-    if (!o->scene || !o->out)
-        return usage("--scene (or --path) and --out are required");
+    if (!o->scene || (!o->out && !o->video))
+        return usage("--scene (or --path) and --out (or --video) are required");
+    if (o->crf >= 0 && !o->video)
+        return usage("--crf sets the quality of --video");
     return 0;
 }
 
@@ -214,7 +230,10 @@ static int check_outputs(const options *o)
     static const char *const depth_exts[] = {".pfm", NULL};
     static const char *const stats_exts[] = {".json", NULL};
     /* The extension sets are disjoint, so no two outputs can name the same file. */
-    return check_output("--out", o->out, image_exts) && (!o->depth || check_output("--depth", o->depth, depth_exts)) &&
+    static const char *const video_exts[] = {".mp4", ".webm", NULL};
+    return (!o->out || check_output("--out", o->out, image_exts)) &&
+           (!o->video || check_output("--video", o->video, video_exts)) &&
+           (!o->depth || check_output("--depth", o->depth, depth_exts)) &&
            (!o->stats || check_output("--stats", o->stats, stats_exts));
 }
 
@@ -376,7 +395,7 @@ static int check_path_options(options *o, const sl_scene *scene, const sl_techni
                 o->scene, o->frames_given ? "frames" : "depth (not written for paths)");
         return 0;
     }
-    if (!frame_pattern_ok(o->out)) {
+    if (o->out && !frame_pattern_ok(o->out)) {
         fprintf(stderr, "sightline-render: --out %s: a path needs a file name pattern with one %%d or %%0Nd for the "
                         "frame number, e.g. frames/%%05d.png\n", o->out);
         return 0;
@@ -425,6 +444,14 @@ int main(int argc, char **argv)
         sl_scene_deinit(&scene);
         return EXIT_USAGE;
     }
+    sl_err verr = {0};
+    if (o.video && sl_video_check(&(sl_video_desc){o.video, scene.width, scene.height,
+                                                   scene.path ? scene.path->fps : SL_RENDER_VIDEO_FPS, o.crf},
+                                  &verr) != SL_OK) {
+        fprintf(stderr, "sightline-render: %s\n", verr.message);
+        sl_scene_deinit(&scene);
+        return EXIT_BAD_INPUT;
+    }
 
     /* The GPU and its limits first: cheap, and a failure there should not
      * wait for a dataset load. */
@@ -458,6 +485,7 @@ int main(int argc, char **argv)
     sl_params params;
 
     sl_pipeline *pipe = NULL;
+    sl_video_writer *video = NULL;
     int exit_code = EXIT_OK;
     double *gpu_ms = calloc((size_t)o.frames, sizeof(double));
     double *wall_ms = calloc((size_t)o.frames, sizeof(double));
@@ -472,7 +500,15 @@ int main(int argc, char **argv)
     }
     sl_pipeline_set_dataset(pipe, ds);
     ds = NULL; /* owned by the pipeline now */
-    int progress = scene.path && isatty(STDERR_FILENO);
+    double video_fps = scene.path ? scene.path->fps : SL_RENDER_VIDEO_FPS;
+    if (o.video && (st = sl_video_open(&(sl_video_desc){o.video, scene.width, scene.height, video_fps, o.crf}, &video,
+                                       &err)) != SL_OK) {
+        fprintf(stderr, "sightline-render: %s\n", err.message);
+        exit_code = st == SL_ERR_UNSUPPORTED ? EXIT_GPU : EXIT_BAD_INPUT;
+        goto done;
+    }
+    int every_frame = scene.path || video; /* each frame leaves the GPU (files, video) */
+    int progress = every_frame && o.frames > 1 && isatty(STDERR_FILENO);
     double t_start = sl_clock_ms();
     for (int f = 0; f < o.frames; f++) {
         sl_frame_stats stats;
@@ -496,12 +532,14 @@ int main(int argc, char **argv)
         last = stats;
         gpu_ms[f] = stats.gpu_ms;
         wall_ms[f] = stats.wall_ms;
-        if (scene.path) { /* every frame of a path is a file */
-            char name[4096];
-            snprintf(name, sizeof name, o.out, f);
+        if (every_frame) {
             sl_pipeline_read_rgba(pipe, rgba, 1);
-            if ((st = write_image(name, rgba, scene.width, scene.height, &err)) != SL_OK) {
-                fprintf(stderr, "%ssightline-render: %s\n", progress ? "\n" : "", err.message);
+            char name[4096] = "";
+            if (scene.path && o.out)
+                snprintf(name, sizeof name, o.out, f);
+            if ((name[0] && (st = write_image(name, rgba, scene.width, scene.height, &err)) != SL_OK) ||
+                (video && (st = sl_video_write_rgba(video, rgba, &err)) != SL_OK)) {
+                fprintf(stderr, "%ssightline-render: frame %d: %s\n", progress ? "\n" : "", f, err.message);
                 exit_code = EXIT_BAD_INPUT;
                 goto done;
             }
@@ -514,8 +552,9 @@ int main(int argc, char **argv)
     }
     if (progress)
         fputc('\n', stderr);
-    if (!scene.path) {
-        sl_pipeline_read_rgba(pipe, rgba, 1);
+    if (!scene.path && o.out) {
+        if (!every_frame)
+            sl_pipeline_read_rgba(pipe, rgba, 1);
         if ((st = write_image(o.out, rgba, scene.width, scene.height, &err)) != SL_OK) {
             fprintf(stderr, "sightline-render: %s\n", err.message);
             exit_code = EXIT_BAD_INPUT;
@@ -540,14 +579,27 @@ int main(int argc, char **argv)
         exit_code = EXIT_BAD_INPUT;
         goto done;
     }
-    if (scene.path)
+    if (video) {
+        sl_video_summary vs;
+        st = sl_video_close(video, &vs, &err);
+        video = NULL;
+        if (st != SL_OK) {
+            fprintf(stderr, "sightline-render: %s\n", err.message);
+            exit_code = EXIT_BAD_INPUT;
+            goto done;
+        }
+        printf("wrote video %s: %ld frames, %.2f s at %g fps, %s CRF %d, %zu bytes\n", o.video, vs.frames, vs.seconds,
+               video_fps, vs.codec, vs.crf, vs.bytes);
+    }
+    if (o.out && scene.path)
         printf("wrote %d frames %s (%dx%d, %s, %.2f s of path at %g fps) in %.1f s\n", o.frames, o.out, scene.width,
                scene.height, tech->name, (o.frames - 1) / scene.path->fps, scene.path->fps,
                (sl_clock_ms() - t_start) / 1000.0);
-    else
+    else if (o.out)
         printf("wrote %s (%dx%d, %s, %d frame%s)\n", o.out, scene.width, scene.height, tech->name, o.frames,
                o.frames == 1 ? "" : "s");
 done:
+    sl_video_abort(video); /* only after a failure: removes the partial file */
     free(gpu_ms);
     free(wall_ms);
     free(rgba);
