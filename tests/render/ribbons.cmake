@@ -263,6 +263,15 @@ foreach(pipeline geometry mesh flat)
     ${SL_STEPS})
 endforeach()
 
+# The comparison can fail: a chunk set that differed (here the unculled
+# render with radius 0.021 instead of 0.02) is caught by the exact diff.
+rb_test(pipelines.culling_detects_difference ${CMAKE_COMMAND}
+  "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/tornado.json|--out|${RB_OUT}/cull_twin_on.png|--set|camera.orbit.distance=0.45|--set|params.pipeline=geometry"
+  "-DSTEP2=${RB_RENDER}|--scene|${RIBBONS_DIR}/tornado.json|--out|${RB_OUT}/cull_twin_off.png|--set|camera.orbit.distance=0.45|--set|params.pipeline=geometry|--set|params.frustum_culling=false|--set|params.radius=0.021"
+  "-DSTEP3=${RB_DIFF}|${RB_OUT}/cull_twin_on.png|${RB_OUT}/cull_twin_off.png|--max-abs|0"
+  -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_abs\"\\]"
+  ${SL_STEPS})
+
 # ---- stress per pipeline: the degenerate lines of stress.vtk draw without
 # crash or NaN with every pipeline (the checks of stress.degenerate).
 foreach(pipeline geometry mesh flat)
