@@ -50,7 +50,7 @@ static const sl_param_def ribbons_params[] = {
      "shader extrudes each segment; mesh = static triangle mesh built on the CPU (memory-hungry baseline); "
      "flat = two-sided twisting flat quads, no widening, caps or twist lines (they vanish edge-on, like VTK's "
      "ribbon filter)", SL_INVALIDATE_PREPARED},
-    {"sides", SL_PARAM_INT, 3, RB_MAX_SIDES, {8}, NULL, "", "vertices per elliptic cross-section", SL_INVALIDATE_PREPARED},
+    {"sides", SL_PARAM_INT, 3, RB_MAX_SIDES, {8}, NULL, "", "vertices per elliptic cross-section (flat: unused)", SL_INVALIDATE_PREPARED},
     {"halo", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "silhouette-point halos", SL_INVALIDATE_FRAME},
     {"halo_width", SL_PARAM_FLOAT, 0.0, 64.0, {0.1}, NULL, "",
      "outline width: a fraction of the half-chord (halo_space object) or pixels (screen)", SL_INVALIDATE_FRAME},
@@ -161,7 +161,9 @@ static sl_status ribbons_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_par
     }
     s->gpu_bytes = s->gpu.buffer_bytes + sl_line_colors_bytes(&s->colors);
     glFinish();
-    s->prep.upload_ms = sl_clock_ms() - t_upload;
+    /* The mesh (or pair) building is CPU preprocessing; compiles are neither. */
+    s->prep.preprocess_ms += s->gpu.cpu_ms;
+    s->prep.upload_ms = sl_clock_ms() - t_upload - s->gpu.cpu_ms - s->gpu.compile_ms;
     st = sl_gl_check_errors("ribbons: uploading the points", err);
     if (st != SL_OK) {
         ribbons_release(s);

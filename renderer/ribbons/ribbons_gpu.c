@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "ribbons_mesh.h"
+#include "../core/sl_clock.h"
 #include "../gpu/sl_gpu.h"
 
 #define RB_GS_COMPONENTS 21
@@ -91,7 +92,9 @@ static void pass_init(rb_pass *p, GLuint program, GLuint vao, GLenum mode, GLenu
 static sl_status program_add(rb_gpu *g, const sl_program_desc *desc, GLuint *out, sl_err *err)
 {
     GLuint p = 0;
+    double t0 = sl_clock_ms();
     sl_status st = sl_gl_program_create(desc, &p, err);
+    g->compile_ms += sl_clock_ms() - t0;
     if (st == SL_OK)
         g->programs[g->program_count++] = p;
     *out = p;
@@ -193,6 +196,7 @@ static sl_status build_geometry(rb_gpu *g, const sl_ribbons_points *pts, const s
         st = pattern_create(g, N, N, 0, 1, &cap_ibo, cap_offsets, err);
     if (st != SL_OK)
         return st;
+    double t0 = sl_clock_ms();
     size_t segments = 0;
     for (size_t c = 0; c < chunk_count; c++)
         segments += chunks[c].segments;
@@ -209,6 +213,7 @@ static sl_status build_geometry(rb_gpu *g, const sl_ribbons_points *pts, const s
         }
         pattern_caps(g, c, ch, sl_ribbons_chunk_caps(l, ch), cap_offsets);
     }
+    g->cpu_ms = sl_clock_ms() - t0;
     GLuint pair_ibo = buffer_create(g, k * sizeof *pairs, pairs);
     free(pairs);
     point_buffers_create(g, pts);
@@ -233,7 +238,9 @@ static sl_status build_mesh(rb_gpu *g, const sl_ribbons_points *pts, const sl_li
     if (st != SL_OK)
         return st;
     sl_ribbons_mesh m;
+    double t0 = sl_clock_ms();
     st = sl_ribbons_mesh_build(pts, l, chunks, chunk_count, N, &m, err);
+    g->cpu_ms = sl_clock_ms() - t0;
     if (st != SL_OK)
         return st;
     const GLsizei cap = 3 * (N - 2);
@@ -280,6 +287,11 @@ sl_status rb_gpu_build(rb_gpu *g, rb_pipeline pipeline, int sides, const sl_ribb
     memset(g, 0, sizeof *g);
     g->pipeline = pipeline;
     g->sides = pipeline == RB_PIPELINE_FLAT ? 2 : sides;
+    /* Pattern draws address vertex point * N through basevertex and gl_VertexID (GLint). */
+    if (pipeline != RB_PIPELINE_MESH && pts->count > (size_t)INT32_MAX / (size_t)g->sides)
+        return sl_err_set(err, SL_ERR_LIMIT,
+                          "ribbons: %zu points x %d ring vertices exceed the 2^31 vertex ids of pipeline %s; lower "
+                          "'sides'", pts->count, g->sides, pipeline == RB_PIPELINE_FLAT ? "flat" : "pulling/geometry");
     for (int j = 0; j < g->sides; j++) {
         double phi = pipeline == RB_PIPELINE_FLAT ? M_PI * (2 * j - 1) / 2.0 : 2.0 * M_PI * j / g->sides;
         g->ring[2 * j] = pipeline == RB_PIPELINE_FLAT ? 0.0f : (float)cos(phi);

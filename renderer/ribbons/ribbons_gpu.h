@@ -59,11 +59,13 @@ typedef struct rb_gpu {
     double *triangles;          /* per chunk, mantle + caps */
     rb_pass passes[2];          /* mantle, caps */
     int gs_invocations, gs_columns; /* geometry only */
+    double cpu_ms, compile_ms;  /* of the build: CPU mesh / pair building, program compiles */
 } rb_gpu;
 
 /* Builds g for pipeline with `sides` on the packed points and the chunks of
- * l. SL_ERR_LIMIT when the geometry shader limits cannot hold a ring or the
- * mesh does not fit 32-bit indices, SL_ERR_GPU / SL_ERR_NOMEM; g is released
+ * l. SL_ERR_LIMIT when the geometry shader limits cannot hold a ring, the
+ * mesh does not fit 32-bit indices or points x N exceed the GLint vertex ids
+ * of the pattern pipelines, SL_ERR_GPU / SL_ERR_NOMEM; g is released (zeroed)
  * on failure. */
 sl_status rb_gpu_build(rb_gpu *g, rb_pipeline pipeline, int sides, const sl_ribbons_points *pts, const sl_lines *l,
                        const sl_line_chunk *chunks, size_t chunk_count, sl_err *err);
