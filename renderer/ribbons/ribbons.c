@@ -2,21 +2,24 @@
  *
  * Neuhauser, Wang, Kern, Westermann, "Efficient high-quality rendering of
  * ribbons and twisted lines": generalized cylinders of elliptic profile
- * (Sec. 3.1) drawn by programmable pulling (Sec. 5): three std430 buffers of
- * per-point data (ribbons_prep.c) and one u16 chunk-pattern index buffer of
- * K segments (plus the two caps) drawn per chunk with
- * glMultiDrawElementsBaseVertex; the vertex shader derives point and ring
- * from gl_VertexID. Only `pulling` exists so far (geometry, mesh and flat
- * are not listed until they work). Width, min_pixels widening (Sec. 7.2),
- * halos (Sec. 3.2), twist lines (Sec. 4), the depth cue and the whole line
- * style are uniforms; per frame only the chunk culling and the multi-draw
- * arrays in client memory are rebuilt — no GL buffer is written on a camera
- * move. Render thread only. Plan: docs/ribbons_plan.md §1, §3.
+ * (Sec. 3.1). `pipeline` picks how the geometry is made (Sec. 5;
+ * ribbons_gpu.c builds each): pulling (default; per-point storage buffers
+ * and one u16 chunk pattern drawn per chunk with basevertex), geometry
+ * (geometry-shader extrusion per segment), mesh (a static CPU-built mesh,
+ * the memory-hungry baseline) and flat (two-sided twisting flat quads that
+ * vanish edge-on, the vtkRibbonFilter look). All four share the packed points
+ * (ribbons_prep.c), the chunks of sl_lines_chunks_build, the per-frame
+ * chunk culling and front-to-back sort here, ribbons_ring.glsl and the one
+ * ribbons.frag.glsl. Width, min_pixels widening (Sec. 7.2), halos (Sec.
+ * 3.2), twist lines (Sec. 4), the depth cue and the whole line style are
+ * uniforms; per frame only the multi-draw arrays in client memory are
+ * rebuilt — no GL buffer is written on a camera move. Render thread only.
+ * Plan: docs/ribbons_plan.md §1, §3.
  */
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
+#include "ribbons_gpu.h"
 #include "ribbons_prep.h"
 #include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
@@ -26,11 +29,8 @@
 #include "../lines/sl_line_gpu.h"
 #include "../lines/sl_lines_prep.h"
 
-#define RB_CHUNK_SEGMENTS 64u   /* K: 65 rings of <= 32 vertices fit u16 indices */
-#define RB_MAX_SIDES 32
-
 static const char *const rb_frame_names[] = {"auto", "transport", "helicity", "data", NULL};
-static const char *const rb_pipeline_names[] = {"pulling", NULL};
+static const char *const rb_pipeline_names[] = {"pulling", "geometry", "mesh", "flat", NULL};
 static const char *const rb_halo_space_names[] = {"object", "screen", NULL};
 
 static const sl_param_def ribbons_params[] = {
@@ -46,8 +46,11 @@ static const sl_param_def ribbons_params[] = {
      "ribbon orientation: auto = data normals, else helicity, else transport; transport = parallel transport; "
      "helicity = normals rotated by the accumulated helicity; data = the dataset's normals", SL_INVALIDATE_PREPARED},
     {"pipeline", SL_PARAM_ENUM, 0, 0, {0}, rb_pipeline_names, "",
-     "how the geometry is made: pulling = vertex shader fetches points from storage buffers", SL_INVALIDATE_PREPARED},
-    {"sides", SL_PARAM_INT, 3, RB_MAX_SIDES, {8}, NULL, "", "vertices per elliptic cross-section", SL_INVALIDATE_PREPARED},
+     "how the geometry is made: pulling = vertex shader fetches points from storage buffers; geometry = geometry "
+     "shader extrudes each segment; mesh = static triangle mesh built on the CPU (memory-hungry baseline); "
+     "flat = two-sided twisting flat quads, no widening, caps or twist lines (they vanish edge-on, like VTK's "
+     "ribbon filter)", SL_INVALIDATE_PREPARED},
+    {"sides", SL_PARAM_INT, 3, RB_MAX_SIDES, {8}, NULL, "", "vertices per elliptic cross-section (flat: unused)", SL_INVALIDATE_PREPARED},
     {"halo", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "silhouette-point halos", SL_INVALIDATE_FRAME},
     {"halo_width", SL_PARAM_FLOAT, 0.0, 64.0, {0.1}, NULL, "",
      "outline width: a fraction of the half-chord (halo_space object) or pixels (screen)", SL_INVALIDATE_FRAME},
@@ -74,19 +77,13 @@ typedef struct rb_draw { /* one visible chunk, for the sort */
 
 typedef struct ribbons_state {
     const sl_dataset *dataset;  /* borrowed */
-    GLuint program, vao, ibo, camera_ubo, points[3];
+    GLuint camera_ubo;
+    rb_gpu gpu;                 /* the pipeline's programs, buffers and per-chunk ranges */
     sl_line_colors colors;      /* colormap texture + colour scalars (SSBO 1) */
     sl_ribbons_frame frame;
-    int sides;
-    float ring[2 * RB_MAX_SIDES];
     sl_line_chunk *chunks;      /* owned */
     size_t chunk_count;
-    uint8_t *chunk_caps;        /* per chunk: bit 0 start cap, bit 1 end cap */
     rb_draw *order;             /* per-frame scratch, chunk_count entries */
-    GLsizei *counts, *cap_counts;
-    GLint *bases, *cap_bases;
-    const void **offsets, **cap_offsets;
-    size_t cap_start_offset, cap_end_offset; /* bytes into ibo */
     float max_data_radius;      /* largest |radius| in the points; < 0 none */
     int has_default_radius;     /* some point uses the `radius` uniform */
     size_t gpu_bytes;
@@ -98,52 +95,12 @@ static void ribbons_release(void *opaque)
     ribbons_state *s = opaque;
     if (!s)
         return;
-    if (s->program) glDeleteProgram(s->program);
-    if (s->vao) glDeleteVertexArrays(1, &s->vao);
-    if (s->ibo) glDeleteBuffers(1, &s->ibo);
+    rb_gpu_release(&s->gpu);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
-    for (int i = 0; i < 3; i++)
-        if (s->points[i]) glDeleteBuffers(1, &s->points[i]);
     sl_line_colors_deinit(&s->colors);
     free(s->chunks);
-    free(s->chunk_caps);
     free(s->order);
-    free(s->counts);
-    free(s->cap_counts);
-    free(s->bases);
-    free(s->cap_bases);
-    free(s->offsets);
-    free(s->cap_offsets);
     free(s);
-}
-
-/* The mantle pattern for K segments followed by the start and end caps. */
-static uint16_t *pattern_build(int N, size_t *count)
-{
-    size_t mantle = 6u * (size_t)N * RB_CHUNK_SEGMENTS, cap = 3u * (size_t)(N - 2);
-    *count = mantle + 2 * cap;
-    uint16_t *idx = malloc(*count * sizeof *idx);
-    if (!idx)
-        return NULL;
-    size_t k = 0;
-    for (unsigned s = 0; s < RB_CHUNK_SEGMENTS; s++)
-        for (int j = 0; j < N; j++) {
-            unsigned j1 = (unsigned)(j + 1) % (unsigned)N, a = s * (unsigned)N, c = (s + 1) * (unsigned)N;
-            const unsigned tri[6] = {a + (unsigned)j, a + j1, c + (unsigned)j, c + (unsigned)j, a + j1, c + j1};
-            for (int q = 0; q < 6; q++)
-                idx[k++] = (uint16_t)tri[q];
-        }
-    for (int j = 1; j <= N - 2; j++) { /* start cap faces -t */
-        idx[k++] = 0;
-        idx[k++] = (uint16_t)(j + 1);
-        idx[k++] = (uint16_t)j;
-    }
-    for (int j = 1; j <= N - 2; j++) {
-        idx[k++] = 0;
-        idx[k++] = (uint16_t)j;
-        idx[k++] = (uint16_t)(j + 1);
-    }
-    return idx;
 }
 
 static sl_status ribbons_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
@@ -163,12 +120,6 @@ static sl_status ribbons_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_par
         return sl_err_set(err, SL_ERR_NOMEM, "ribbons: out of memory");
     s->dataset = ds;
     s->frame = frame;
-    s->sides = sl_params_int(params, "sides");
-    for (int j = 0; j < s->sides; j++) {
-        double phi = 2.0 * M_PI * j / s->sides;
-        s->ring[2 * j] = (float)cos(phi);
-        s->ring[2 * j + 1] = (float)sin(phi);
-    }
     sl_line_style style;
     sl_line_style_read(params, ds, &style);
     const sl_lines *l = &ds->lines;
@@ -180,31 +131,15 @@ static sl_status ribbons_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_par
         return st;
     }
     st = sl_lines_chunks_build(l, RB_CHUNK_SEGMENTS, &s->chunks, &s->chunk_count, err);
-    size_t n = s->chunk_count ? s->chunk_count : 1;
     if (st == SL_OK) {
-        s->chunk_caps = calloc(n, 1);
-        s->order = malloc(n * sizeof *s->order);
-        s->counts = malloc(n * sizeof *s->counts);
-        s->bases = malloc(n * sizeof *s->bases);
-        s->offsets = malloc(n * sizeof *s->offsets);
-        s->cap_counts = malloc(2 * n * sizeof *s->cap_counts);
-        s->cap_bases = malloc(2 * n * sizeof *s->cap_bases);
-        s->cap_offsets = malloc(2 * n * sizeof *s->cap_offsets);
-        if (!s->chunk_caps || !s->order || !s->counts || !s->bases || !s->offsets || !s->cap_counts ||
-            !s->cap_bases || !s->cap_offsets)
+        s->order = malloc((s->chunk_count ? s->chunk_count : 1) * sizeof *s->order);
+        if (!s->order)
             st = sl_err_set(err, SL_ERR_NOMEM, "ribbons: out of memory for %zu chunks", s->chunk_count);
     }
     if (st != SL_OK) {
         sl_ribbons_points_deinit(&pts);
         ribbons_release(s);
         return st;
-    }
-    for (size_t c = 0; c < s->chunk_count; c++) {
-        const sl_line_chunk *ch = &s->chunks[c];
-        if (ch->first_point == l->line_offsets[ch->line])
-            s->chunk_caps[c] |= 1;
-        if (ch->first_point + ch->segments + 1 == l->line_offsets[ch->line + 1])
-            s->chunk_caps[c] |= 2;
     }
     s->max_data_radius = -1.0f;
     for (size_t i = 0; i < pts.count; i++) {
@@ -215,45 +150,21 @@ static sl_status ribbons_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_par
             s->max_data_radius = r;
     }
     s->prep.preprocess_ms = sl_clock_ms() - t_build;
-    st = sl_gl_program_create(&(sl_program_desc){
-        .vertex = "ribbons/ribbons_pull.vert.glsl",
-        .fragment = "ribbons/ribbons.frag.glsl",
-        .label = "ribbons"}, &s->program, err);
-    if (st != SL_OK) {
-        sl_ribbons_points_deinit(&pts);
-        ribbons_release(s);
-        return st;
-    }
     double t_upload = sl_clock_ms();
-    size_t pattern_count = 0;
-    uint16_t *pattern = pattern_build(s->sides, &pattern_count);
-    if (!pattern) {
-        sl_ribbons_points_deinit(&pts);
-        ribbons_release(s);
-        return sl_err_set(err, SL_ERR_NOMEM, "ribbons: out of memory for the index pattern");
-    }
-    size_t cap = 3u * (size_t)(s->sides - 2);
-    s->cap_start_offset = (pattern_count - 2 * cap) * sizeof(uint16_t);
-    s->cap_end_offset = (pattern_count - cap) * sizeof(uint16_t);
-    glCreateBuffers(1, &s->ibo);
-    glNamedBufferStorage(s->ibo, (GLsizeiptr)(pattern_count * sizeof *pattern), pattern, 0);
-    free(pattern);
-    const float *arrays[3] = {pts.pos_radius, pts.normal_twist, pts.tangent_slope};
-    size_t bytes = (pts.count ? pts.count : 1) * 4 * sizeof(float);
-    glCreateBuffers(3, s->points);
-    for (int i = 0; i < 3; i++)
-        glNamedBufferStorage(s->points[i], (GLsizeiptr)bytes, pts.count ? arrays[i] : NULL, 0);
+    st = rb_gpu_build(&s->gpu, (rb_pipeline)sl_params_choice(params, "pipeline"), sl_params_int(params, "sides"),
+                      &pts, l, s->chunks, s->chunk_count, err);
     sl_ribbons_points_deinit(&pts);
-    glCreateVertexArrays(1, &s->vao);
-    glVertexArrayElementBuffer(s->vao, s->ibo);
-    st = sl_line_colors_init(&s->colors, l->vertex_count, 1, "ribbons", err);
+    if (st == SL_OK)
+        st = sl_line_colors_init(&s->colors, l->vertex_count, 1, "ribbons", err);
     if (st != SL_OK) {
         ribbons_release(s);
         return st;
     }
-    s->gpu_bytes = 3 * bytes + pattern_count * sizeof(uint16_t) + sl_line_colors_bytes(&s->colors);
+    s->gpu_bytes = s->gpu.buffer_bytes + sl_line_colors_bytes(&s->colors);
     glFinish();
-    s->prep.upload_ms = sl_clock_ms() - t_upload;
+    /* The mesh (or pair) building is CPU preprocessing; compiles are neither. */
+    s->prep.preprocess_ms += s->gpu.cpu_ms;
+    s->prep.upload_ms = sl_clock_ms() - t_upload - s->gpu.cpu_ms - s->gpu.compile_ms;
     st = sl_gl_check_errors("ribbons: uploading the points", err);
     if (st != SL_OK) {
         ribbons_release(s);
@@ -271,9 +182,70 @@ static int draw_cmp(const void *a, const void *b)
     return x->chunk < y->chunk ? -1 : x->chunk > y->chunk;
 }
 
-static GLint uniform(GLuint program, const char *name)
+/* The per-frame loop of every pipeline: each chunk's box, grown by the
+ * largest radius, against the frustum (unless culling is off), the visible
+ * ones sorted front to back by box centre and their ranges appended to the
+ * pipeline's multi-draw arrays (client memory). Triangle counts to stats. */
+static void chunks_select(ribbons_state *s, const sl_view *view, double r_max, int cull, sl_render_stats *stats)
 {
-    return glGetUniformLocation(program, name);
+    sl_vec3 e = sl_v3_sub(view->camera.eye, view->origin);
+    const double eye[3] = {e.x, e.y, e.z};
+    size_t visible = 0;
+    double tri_all = 0.0, tri_drawn = 0.0;
+    for (size_t c = 0; c < s->chunk_count; c++) {
+        const sl_line_chunk *ch = &s->chunks[c];
+        tri_all += s->gpu.triangles[c];
+        if (cull && !sl_lines_box_visible(view, view->origin, ch->lo, ch->hi, r_max))
+            continue;
+        double d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = 0.5 * ((double)ch->lo[k] + ch->hi[k]) - eye[k];
+        s->order[visible++] = (rb_draw){d[0] * d[0] + d[1] * d[1] + d[2] * d[2], (uint32_t)c};
+    }
+    qsort(s->order, visible, sizeof *s->order, draw_cmp);
+    s->gpu.passes[0].drawcount = s->gpu.passes[1].drawcount = 0;
+    for (size_t v = 0; v < visible; v++) {
+        rb_gpu_add_chunk(&s->gpu, s->order[v].chunk);
+        tri_drawn += s->gpu.triangles[s->order[v].chunk];
+    }
+    stats->primitives = tri_drawn;
+    stats->culled = tri_all - tri_drawn;
+}
+
+/* The uniforms of ribbons_vertex.glsl, ribbons_ring.glsl and ribbons.frag.glsl on program p. */
+static void uniforms_set(const ribbons_state *s, GLuint p, const sl_view *view, const sl_params *params,
+                         const sl_line_style *style)
+{
+    const rb_gpu *g = &s->gpu;
+    const int N = g->sides, flat = g->pipeline == RB_PIPELINE_FLAT;
+    glUseProgram(p);
+    sl_line_style_uniforms(p, style, 0);
+    glUniform1ui(glGetUniformLocation(p, "u_sides"), (GLuint)N);
+    glUniform2fv(glGetUniformLocation(p, "u_ring"), N, g->ring);
+    glUniform1f(glGetUniformLocation(p, "u_cos_pi_n"), (float)cos(M_PI / N));
+    glUniform1i(glGetUniformLocation(p, "u_flat"), flat);
+    /* flat: no widening (ring cos = 0 anyway) and a halo band of exactly halo_width. */
+    glUniform1f(glGetUniformLocation(p, "u_halo_min"), flat ? 0.0f : (float)(1.0 - cos(M_PI / N)));
+    glUniform1f(glGetUniformLocation(p, "u_width_ratio"), flat ? 0.0f : (float)sl_params_float(params, "width_ratio"));
+    glUniform1f(glGetUniformLocation(p, "u_min_thickness"),
+                flat ? 0.0f : (float)sl_params_float(params, "min_thickness"));
+    glUniform1f(glGetUniformLocation(p, "u_min_pixels"), flat ? 0.0f : (float)sl_params_float(params, "min_pixels"));
+    glUniform1f(glGetUniformLocation(p, "u_twist_scale"), (float)sl_params_float(params, "twist_scale"));
+    glUniform1i(glGetUniformLocation(p, "u_rotate"), s->frame == SL_RIBBONS_FRAME_HELICITY);
+    glUniform1i(glGetUniformLocation(p, "u_twist_lines"), sl_params_int(params, "twist_lines"));
+    glUniform1f(glGetUniformLocation(p, "u_twist_width"), (float)sl_params_float(params, "twist_width"));
+    glUniform1i(glGetUniformLocation(p, "u_halo"), sl_params_bool(params, "halo"));
+    glUniform1i(glGetUniformLocation(p, "u_halo_screen"), sl_params_choice(params, "halo_space") == 1);
+    glUniform1f(glGetUniformLocation(p, "u_halo_width"), (float)sl_params_float(params, "halo_width"));
+    float halo_color[3];
+    sl_params_vec3(params, "halo_color", halo_color);
+    glUniform3fv(glGetUniformLocation(p, "u_halo_color"), 1, halo_color);
+    glUniform1f(glGetUniformLocation(p, "u_depth_cue"), (float)sl_params_float(params, "depth_cue"));
+    /* Depth cue range: the eye distances of the data's bounding sphere. */
+    sl_vec3 centre = sl_v3_scale(sl_v3_add(s->dataset->bounds_min, s->dataset->bounds_max), 0.5);
+    double radius = 0.5 * sl_v3_length(sl_v3_sub(s->dataset->bounds_max, s->dataset->bounds_min));
+    double dist = sl_v3_length(sl_v3_sub(centre, view->camera.eye));
+    glUniform2f(glGetUniformLocation(p, "u_depth_range"), (float)fmax(dist - radius, 0.0), (float)(dist + radius));
 }
 
 static sl_status ribbons_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
@@ -286,105 +258,21 @@ static sl_status ribbons_render(void *opaque, const sl_view *view, const sl_para
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    const int N = s->sides;
-
-    /* Chunks: cull (optionally) and sort front to back by box centre. */
     double r_max = s->has_default_radius ? style.radius : 0.0;
     if (s->max_data_radius >= 0.0f)
         r_max = fmax(r_max, (double)s->max_data_radius * style.radius_scale);
-    int cull = sl_params_bool(params, "frustum_culling");
-    sl_vec3 e = sl_v3_sub(view->camera.eye, view->origin);
-    const double eye[3] = {e.x, e.y, e.z};
-    size_t visible = 0;
-    double tri_all = 0.0;
-    for (size_t c = 0; c < s->chunk_count; c++) {
-        const sl_line_chunk *ch = &s->chunks[c];
-        double tri = 2.0 * N * ch->segments + (N - 2) * (double)((s->chunk_caps[c] & 1) + (s->chunk_caps[c] >> 1));
-        tri_all += tri;
-        if (cull && !sl_lines_box_visible(view, view->origin, ch->lo, ch->hi, r_max))
-            continue;
-        double d[3];
-        for (int k = 0; k < 3; k++)
-            d[k] = 0.5 * ((double)ch->lo[k] + ch->hi[k]) - eye[k];
-        s->order[visible++] = (rb_draw){d[0] * d[0] + d[1] * d[1] + d[2] * d[2], (uint32_t)c};
-    }
-    qsort(s->order, visible, sizeof *s->order, draw_cmp);
-    size_t caps = 0;
-    double tri_drawn = 0.0;
-    for (size_t v = 0; v < visible; v++) {
-        uint32_t c = s->order[v].chunk;
-        const sl_line_chunk *ch = &s->chunks[c];
-        s->counts[v] = (GLsizei)(6u * (unsigned)N * ch->segments);
-        s->bases[v] = (GLint)(ch->first_point * (uint32_t)N);
-        s->offsets[v] = NULL;
-        tri_drawn += 2.0 * N * ch->segments;
-        if (s->chunk_caps[c] & 1) {
-            s->cap_counts[caps] = 3 * (N - 2);
-            s->cap_bases[caps] = (GLint)(ch->first_point * (uint32_t)N);
-            s->cap_offsets[caps++] = (const void *)(uintptr_t)s->cap_start_offset;
-        }
-        if (s->chunk_caps[c] & 2) {
-            s->cap_counts[caps] = 3 * (N - 2);
-            s->cap_bases[caps] = (GLint)((ch->first_point + ch->segments) * (uint32_t)N);
-            s->cap_offsets[caps++] = (const void *)(uintptr_t)s->cap_end_offset;
-        }
-    }
-    tri_drawn += (double)caps * (N - 2);
+    chunks_select(s, view, r_max, sl_params_bool(params, "frustum_culling"), stats);
 
     sl_line_colors_update(&s->colors, &s->dataset->lines, &style);
     sl_line_colors_bind(&s->colors, 0, 1);
-    for (GLuint i = 0; i < 3; i++)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2 + i, s->points[i]);
     sl_camera_ubo_update(&s->camera_ubo, view);
-    GLuint p = s->program;
-    glUseProgram(p);
-    sl_line_style_uniforms(p, &style, 0);
-    glUniform1ui(uniform(p, "u_sides"), (GLuint)N);
-    glUniform2fv(uniform(p, "u_ring"), N, s->ring);
-    glUniform1f(uniform(p, "u_cos_pi_n"), (float)cos(M_PI / N));
-    glUniform1f(uniform(p, "u_halo_min"), (float)(1.0 - cos(M_PI / N)));
-    glUniform1f(uniform(p, "u_width_ratio"), (float)sl_params_float(params, "width_ratio"));
-    glUniform1f(uniform(p, "u_min_thickness"), (float)sl_params_float(params, "min_thickness"));
-    glUniform1f(uniform(p, "u_min_pixels"), (float)sl_params_float(params, "min_pixels"));
-    glUniform1f(uniform(p, "u_twist_scale"), (float)sl_params_float(params, "twist_scale"));
-    glUniform1i(uniform(p, "u_rotate"), s->frame == SL_RIBBONS_FRAME_HELICITY);
-    glUniform1i(uniform(p, "u_twist_lines"), sl_params_int(params, "twist_lines"));
-    glUniform1f(uniform(p, "u_twist_width"), (float)sl_params_float(params, "twist_width"));
-    glUniform1i(uniform(p, "u_halo"), sl_params_bool(params, "halo"));
-    glUniform1i(uniform(p, "u_halo_screen"), sl_params_choice(params, "halo_space") == 1);
-    glUniform1f(uniform(p, "u_halo_width"), (float)sl_params_float(params, "halo_width"));
-    float halo_color[3];
-    sl_params_vec3(params, "halo_color", halo_color);
-    glUniform3fv(uniform(p, "u_halo_color"), 1, halo_color);
-    glUniform1f(uniform(p, "u_depth_cue"), (float)sl_params_float(params, "depth_cue"));
-    /* Depth cue range: the eye distances of the data's bounding sphere. */
-    sl_vec3 centre = sl_v3_scale(sl_v3_add(s->dataset->bounds_min, s->dataset->bounds_max), 0.5);
-    double radius = 0.5 * sl_v3_length(sl_v3_sub(s->dataset->bounds_max, s->dataset->bounds_min));
-    double dist = sl_v3_length(sl_v3_sub(centre, view->camera.eye));
-    glUniform2f(uniform(p, "u_depth_range"), (float)fmax(dist - radius, 0.0), (float)(dist + radius));
-
+    for (int i = 0; i < s->gpu.program_count; i++)
+        uniforms_set(s, s->gpu.programs[i], view, params, &style);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
-    glEnable(GL_CULL_FACE); /* closed surfaces (caps always on) */
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
-    glBindVertexArray(s->vao);
-    if (visible) {
-        glUniform1i(uniform(p, "u_cap"), 0);
-        glMultiDrawElementsBaseVertex(GL_TRIANGLES, s->counts, GL_UNSIGNED_SHORT, s->offsets, (GLsizei)visible,
-                                      s->bases);
-    }
-    if (caps && N > 2) {
-        glUniform1i(uniform(p, "u_cap"), 1);
-        glMultiDrawElementsBaseVertex(GL_TRIANGLES, s->cap_counts, GL_UNSIGNED_SHORT, s->cap_offsets,
-                                      (GLsizei)caps, s->cap_bases);
-    }
-    glBindVertexArray(0);
-    glDisable(GL_CULL_FACE);
-    stats->primitives = tri_drawn;
-    stats->culled = tri_all - tri_drawn;
+    rb_gpu_draw(&s->gpu); /* face culling per pass: closed surfaces except flat */
     return SL_OK;
 }
 
