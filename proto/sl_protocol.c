@@ -37,6 +37,8 @@ static const msg_spec specs[] = {
     {"snapshot", SL_MSG_SNAPSHOT, {NULL}},
     {"control", SL_MSG_CONTROL, {"action", "client", NULL}},
     {"ping", SL_MSG_PING, {"seq", NULL}},
+    {"record", SL_MSG_RECORD, {"path", "format", "crf", NULL}},
+    {"record_cancel", SL_MSG_RECORD_CANCEL, {NULL}},
 };
 
 static sl_status fail(sl_msg *msg, char *code, char *field, const char *c, const char *f,
@@ -225,6 +227,20 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg, char *code, ch
         msg->client = r ? (int)v : 0;
         break;
     }
+    case SL_MSG_RECORD:
+        msg->path = cJSON_GetObjectItemCaseSensitive(root, "path");
+        if (!cJSON_IsObject(msg->path))
+            return fail(msg, code, field, "bad_field", "path", err, "record needs a \"path\" object (scene.md, Paths)%s", "");
+        r = get_string(root, "format", msg->format, sizeof msg->format);
+        if (r < 0 || (r == 1 && strcmp(msg->format, "mp4") != 0 && strcmp(msg->format, "webm") != 0))
+            return fail(msg, code, field, "bad_field", "format", err, "\"format\" must be \"mp4\" or \"webm\"%s", "");
+        if (r == 0)
+            snprintf(msg->format, sizeof msg->format, "mp4");
+        r = get_int(root, "crf", 0, 63, &v);
+        if (r < 0)
+            return fail(msg, code, field, "bad_field", "crf", err, "\"crf\" must be an integer in [0, 63]%s", "");
+        msg->crf = r ? (int)v : -1;
+        break;
     case SL_MSG_PING:
         if (get_int(root, "seq", 0, 9007199254740991.0, &v) < 0)
             return fail(msg, code, field, "bad_field", "seq", err, "\"seq\" must be an integer%s", "");

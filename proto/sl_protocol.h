@@ -46,6 +46,8 @@ typedef enum sl_msg_type {
     SL_MSG_SNAPSHOT,
     SL_MSG_CONTROL,
     SL_MSG_PING,
+    SL_MSG_RECORD,
+    SL_MSG_RECORD_CANCEL,
 } sl_msg_type;
 
 typedef enum sl_camera_phase {
@@ -81,6 +83,9 @@ typedef struct sl_msg {
     uint32_t frame_id;                /* ack */
     sl_control_action action;         /* control */
     int client;                       /* control grant: target client id */
+    const cJSON *path;                /* record: the path object (scene.md "Paths"), borrowed */
+    char format[8];                   /* record: "mp4" or "webm" */
+    int crf;                          /* record: -1 = the codec's default */
 } sl_msg;
 
 /* Parses one client text message of `len` bytes (need not be NUL-terminated).

@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/sl_technique.h"
 #include "sl_params_json.h"
@@ -285,6 +286,13 @@ int main(int argc, char **argv)
     const sl_technique *const *techs = sl_technique_list(&tc);
     for (int i = 0; i < tc; i++)
         cJSON_AddItemToArray(srv->techniques_json, sl_technique_json(techs[i]));
+    /* Recording files (record.c) live here until fetched or their job ends. */
+    snprintf(srv->record_dir, sizeof srv->record_dir, "/tmp/sightline-recordings-XXXXXX");
+    if (!mkdtemp(srv->record_dir)) {
+        fprintf(stderr, "sightline-server: warning: no folder for recordings (%s): record is refused\n",
+                strerror(errno));
+        srv->record_dir[0] = '\0';
+    }
     if (sl_render_start(srv, &err) != SL_OK) {
         fprintf(stderr, "sightline-server: %s\n", err.message);
         goto done;
@@ -304,7 +312,9 @@ int main(int argc, char **argv)
 done:
     sl_render_stop(srv);
     sl_ws_destroy(srv);
-    sl_sessions_destroy_all(srv);
+    sl_sessions_destroy_all(srv); /* removes every recording file */
+    if (srv->record_dir[0] && rmdir(srv->record_dir) != 0)
+        fprintf(stderr, "sightline-server: warning: %s not removed: %s\n", srv->record_dir, strerror(errno));
     sl_catalog_close(srv->db);
     cJSON_Delete(srv->techniques_json);
     pthread_cond_destroy(&srv->wake);

@@ -41,9 +41,12 @@
 #include "core/sl_clock.h"
 #include "core/sl_technique.h"
 #include "gpu/sl_gpu.h"
+#include "image/sl_video.h"
 #include "pipeline/sl_pipeline.h"
+#include "sl_params_json.h"
+#include "sl_scene_path.h"
 
-enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT };
+enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT, JOB_RECORD };
 
 typedef struct render_ctx {
     sl_server *srv;
@@ -99,6 +102,8 @@ static sl_session *pick_job(render_ctx *ctx, enum job_kind *kind, double now, do
             *kind = JOB_FRAME;
         } else if (s->rendered_interactive && now >= still_due) {
             *kind = JOB_STILL;
+        } else if (s->record && !s->record->finished) {
+            *kind = JOB_RECORD; /* the session's own frames first: a recording only fills its idle time */
         } else {
             if (s->rendered_interactive && still_due < *deadline_ms)
                 *deadline_ms = still_due;
@@ -552,6 +557,120 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
     pthread_mutex_unlock(&srv->lock);
 }
 
+/* Ends the session's recording job with `state` (and extra fields, consumed). */
+static void record_finish(sl_server *srv, sl_session *s, sl_record_job *j, const char *state, int ok, cJSON *extra)
+{
+    pthread_mutex_lock(&srv->lock);
+    j->finished = 1;
+    j->ok = ok;
+    sl_record_status_locked(s, j, state, extra);
+    pthread_mutex_unlock(&srv->lock);
+}
+
+static void record_fail(sl_server *srv, sl_session *s, sl_record_job *j, int frame, const sl_err *err)
+{
+    sl_video_abort(j->writer);
+    j->writer = NULL;
+    cJSON *x = cJSON_CreateObject();
+    char msg[600];
+    snprintf(msg, sizeof msg, "frame %d: %.560s", frame, err->message);
+    cJSON_AddStringToObject(x, "message", msg);
+    record_finish(srv, s, j, "failed", 0, x);
+}
+
+/* One frame of the session's recording job at full still quality (or its
+ * cancel): the job's base state with the path's camera and parameters at
+ * t = frame / fps, through the session's prepared scene (ready_scene
+ * switches scenes when a keyed parameter needs another prepare: costly,
+ * as scene.md says). The session's latest frame and state are untouched. */
+static void do_record(render_ctx *ctx, sl_session *s, sl_record_job *j, int cancel)
+{
+    sl_server *srv = ctx->srv;
+    if (cancel) {
+        sl_video_abort(j->writer);
+        j->writer = NULL;
+        record_finish(srv, s, j, "cancelled", 0, NULL);
+        return;
+    }
+    sl_err err = {0};
+    int f = j->next_frame;
+    double t = f / j->path->fps;
+    sl_session_state *st = malloc(sizeof *st);
+    if (!st) {
+        sl_err_set(&err, SL_ERR_NOMEM, "out of memory");
+        record_fail(srv, s, j, f, &err);
+        return;
+    }
+    *st = j->base;
+    const sl_technique *tech = sl_technique_find(st->technique);
+    cJSON *keyed = tech ? sl_scene_path_params(j->path, t, NULL, tech) : NULL;
+    sl_status rc = keyed ? sl_params_apply_json(&st->params, keyed, &err)
+                         : sl_err_set(&err, SL_ERR_NOMEM, "no parameters at t = %g", t);
+    cJSON_Delete(keyed);
+    if (rc == SL_OK && !ready_scene(ctx, s, st)) {
+        free(st); /* waiting for a load (tried again later) or failed (reported to the session) */
+        if (!s->load) {
+            cJSON *x = cJSON_CreateObject();
+            cJSON_AddStringToObject(x, "message", "the recording's scene could not be prepared (the session's "
+                                                  "render_failed error says why)");
+            record_finish(srv, s, j, "failed", 0, x);
+        }
+        return;
+    }
+    const sl_dataset *ds = rc == SL_OK ? s->prepared->dataset : NULL;
+    if (rc == SL_OK)
+        rc = sl_camera_path_at(j->path->keys, j->path->key_count, j->path->interpolation, t, ds->bounds_min,
+                               ds->bounds_max, &st->camera, &err);
+    if (rc == SL_OK && !j->writer) {
+        rc = sl_video_open(&(sl_video_desc){j->file, st->width, st->height, j->path->fps, j->crf}, &j->writer, &err);
+        j->t0_ms = sl_clock_ms();
+    }
+    int w = 0, h = 0;
+    double render_ms = 0;
+    if (rc == SL_OK)
+        rc = render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &err);
+    if (rc == SL_OK) {
+        sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 1);
+        test_delay(srv, st, w, h);
+        rc = sl_video_write_rgba(j->writer, ctx->rgba, &err);
+    }
+    free(st);
+    if (rc != SL_OK) {
+        record_fail(srv, s, j, f, &err);
+        return;
+    }
+    j->next_frame++;
+    double spent = (sl_clock_ms() - j->t0_ms) / 1000.0;
+    if (j->next_frame < j->frames) {
+        cJSON *x = cJSON_CreateObject();
+        cJSON_AddNumberToObject(x, "frame", j->next_frame);
+        cJSON_AddNumberToObject(x, "elapsed_s", spent);
+        cJSON_AddNumberToObject(x, "eta_s", spent / j->next_frame * (j->frames - j->next_frame));
+        pthread_mutex_lock(&srv->lock);
+        sl_record_status_locked(s, j, "running", x);
+        pthread_mutex_unlock(&srv->lock);
+        return;
+    }
+    sl_video_summary sum;
+    rc = sl_video_close(j->writer, &sum, &err);
+    j->writer = NULL;
+    if (rc != SL_OK) {
+        record_fail(srv, s, j, f, &err);
+        return;
+    }
+    cJSON *x = cJSON_CreateObject();
+    char url[64];
+    snprintf(url, sizeof url, "/recording/%s", j->key);
+    cJSON_AddNumberToObject(x, "frame", j->frames);
+    cJSON_AddNumberToObject(x, "elapsed_s", spent);
+    cJSON_AddStringToObject(x, "url", url);
+    cJSON_AddNumberToObject(x, "bytes", (double)sum.bytes);
+    cJSON_AddNumberToObject(x, "seconds", sum.seconds);
+    cJSON_AddStringToObject(x, "codec", sum.codec);
+    cJSON_AddNumberToObject(x, "crf", sum.crf);
+    record_finish(srv, s, j, "done", 1, x);
+}
+
 /* Lets go of what the session holds on this thread. */
 static void session_release(render_ctx *ctx, sl_session *s)
 {
@@ -629,6 +748,8 @@ static void *render_main(void *arg)
             memcpy(ids, s->snap_req, sizeof(int) * (size_t)nids);
             s->snap_req_count = 0;
         }
+        sl_record_job *record = kind == JOB_RECORD ? s->record : NULL; /* replaced only once finished */
+        int record_cancel = record && record->cancel;
         int interactive = 0;
         if (kind == JOB_FRAME)
             interactive = copy->phase != SL_PHASE_NONE && now < copy->camera_ms + copy->stream.still_delay_ms;
@@ -636,6 +757,8 @@ static void *render_main(void *arg)
         pthread_mutex_unlock(&srv->lock);
         if (kind == JOB_SNAPSHOT)
             do_snapshot(&ctx, s, copy, ids, nids);
+        else if (kind == JOB_RECORD)
+            do_record(&ctx, s, record, record_cancel);
         else
             do_frame(&ctx, s, copy, interactive);
         lws_cancel_service(srv->lws);

@@ -182,6 +182,8 @@ void sl_session_free(sl_session *s)
     free(s->info_attrs);
     for (int i = 0; i < SL_PROGRESS_RING; i++)
         free(s->progress_text[i]);
+    sl_record_free(s->record);
+    free(s->record_text);
     cJSON_Delete(s->bounds);
     free(s);
 }
@@ -292,6 +294,8 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     c->error_seq = s->error_seq;
     s->idle_since_ms = 0;
     c->progress_seq = s->progress_closed ? s->progress_seq : s->progress_round_start;
+    /* The newest recording state is news while its job runs or waits to be fetched. */
+    c->record_seq = s->record && (!s->record->finished || s->record->ok) ? s->record_seq - 1 : s->record_seq;
     pthread_mutex_unlock(&srv->lock);
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
     sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
@@ -339,6 +343,49 @@ static int require_control(sl_server *srv, sl_client *c, const char *what)
              what);
     send_error(srv, c, "not_controller", msg, "type");
     return 0;
+}
+
+/* record: a new recording job of the session (one at a time). */
+static void on_record(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    pthread_mutex_lock(&srv->lock);
+    int busy = s->record && !s->record->finished;
+    pthread_mutex_unlock(&srv->lock);
+    if (busy) {
+        send_error(srv, c, "busy", "a recording is already running in this session (record_cancel stops it)", "type");
+        return;
+    }
+    sl_record_job *j = NULL;
+    sl_err err = {0};
+    if (sl_record_create(srv, s, m->path, m->format, m->crf, &j, &err) != SL_OK) {
+        send_error(srv, c, "bad_field", err.message, "path");
+        return;
+    }
+    pthread_mutex_lock(&srv->lock);
+    sl_record_job *old = s->record; /* finished: no thread works on it */
+    s->record = j;
+    sl_record_status_locked(s, j, "queued", NULL);
+    pthread_cond_signal(&srv->wake);
+    pthread_mutex_unlock(&srv->lock);
+    sl_record_free(old);
+    for (sl_client *o = s->clients; o; o = o->next)
+        lws_callback_on_writable(o->wsi);
+}
+
+/* record_cancel: stops the running job (its partial file is removed). */
+static void on_record_cancel(sl_server *srv, sl_client *c)
+{
+    sl_session *s = c->session;
+    pthread_mutex_lock(&srv->lock);
+    int running = s->record && !s->record->finished;
+    if (running) {
+        s->record->cancel = 1;
+        pthread_cond_signal(&srv->wake);
+    }
+    pthread_mutex_unlock(&srv->lock);
+    if (!running)
+        send_error(srv, c, "bad_field", "no recording is running in this session", "type");
 }
 
 /* Parses a camera and checks it against the session's dataset bounds (when
@@ -720,6 +767,14 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     case SL_MSG_PING:
         sl_client_queue_text(c, sl_msg_pong_text(m.seq));
         break;
+    case SL_MSG_RECORD:
+        if (require_control(srv, c, "record"))
+            on_record(srv, c, &m);
+        break;
+    case SL_MSG_RECORD_CANCEL:
+        if (require_control(srv, c, "record_cancel"))
+            on_record_cancel(srv, c);
+        break;
     default:
         break;
     }
@@ -831,7 +886,7 @@ void sl_sessions_on_wake(sl_server *srv)
         /* The session's newest render error is sent by write_next (coalesced:
          * a client that is behind gets the latest error once, not a backlog). */
         for (sl_client *c = s->clients; c; c = c->next)
-            if (c->error_seq != s->error_seq || c->progress_seq != s->progress_seq)
+            if (c->error_seq != s->error_seq || c->progress_seq != s->progress_seq || c->record_seq != s->record_seq)
                 lws_callback_on_writable(c->wsi);
     }
     pthread_mutex_unlock(&srv->lock);
@@ -962,6 +1017,15 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     pthread_mutex_unlock(&srv->lock);
     if (error)
         return write_text_now(c, error);
+    char *recording = NULL;
+    pthread_mutex_lock(&srv->lock);
+    if (c->record_seq != s->record_seq) {
+        c->record_seq = s->record_seq;
+        recording = s->record_text ? strdup(s->record_text) : NULL;
+    }
+    pthread_mutex_unlock(&srv->lock);
+    if (recording)
+        return write_text_now(c, recording);
     if (c->snapshot) {
         sl_frame_buf *f = c->snapshot;
         c->snapshot = NULL;

@@ -11,6 +11,9 @@
  *   dataset_cache.c  datasets by source: cached, shared, loaded on its own
  *              loader threads (any caller; its own lock)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
+ *   record.c   recording jobs: a camera path rendered into a video in the
+ *              background of a session, its status texts and its one-time
+ *              download (service thread; the frames render in render.c)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
  *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
@@ -201,6 +204,31 @@ typedef struct sl_progress_round {
 typedef struct sl_client sl_client;
 typedef struct sl_session sl_session;
 
+/* ---- recordings (record.c; frames rendered by render.c) ---- */
+#define SL_RECORD_MAX_FRAMES 3600                     /* frames of one job */
+#define SL_RECORD_MAX_PIXELS (3600.0 * 1920.0 * 1080.0) /* frames x width x height of one job */
+typedef struct sl_scene_path sl_scene_path;
+typedef struct sl_video_writer sl_video_writer;
+typedef struct sl_record_job {
+    /* immutable once created */
+    uint32_t id;                     /* per server, from 1 */
+    sl_scene_path *path;             /* owned */
+    sl_session_state base;           /* the session's state when the job was asked for: size, scene, params */
+    int frames;
+    int crf;                         /* -1: the codec's default */
+    char format[8];                  /* "mp4" or "webm" */
+    char file[320];                  /* where the video is written */
+    char key[33];                    /* the download key (random hex) in the job's URL */
+    /* [lock] */
+    int cancel;                      /* a client asked to cancel */
+    int finished;                    /* nothing more renders: done, cancelled or failed */
+    int ok;                          /* finished with a complete file, not yet downloaded */
+    /* [render] */
+    sl_video_writer *writer;
+    int next_frame;
+    double t0_ms;
+} sl_record_job;
+
 struct sl_client {                  /* [service] */
     struct lws *wsi;
     int id;
@@ -223,6 +251,7 @@ struct sl_client {                  /* [service] */
     uint32_t error_seq;             /* session error_seq already reported (set at attach) */
     int wants_control;              /* asked for control; the controller has not been told yet */
     uint32_t progress_seq;          /* newest session progress text sent (set at attach) */
+    uint32_t record_seq;            /* session record_seq whose text was sent (set at attach) */
     int close_after_send;
     sl_client *next;                /* in session->clients */
 };
@@ -261,6 +290,9 @@ struct sl_session {
     uint32_t progress_round_start;           /* [lock] progress_seq before the current round's first */
     int progress_closed;                     /* [lock] the current round's `done` was posted */
     char *progress_text[SL_PROGRESS_RING];   /* [lock] owned texts, text n at n % SL_PROGRESS_RING */
+    sl_record_job *record;                   /* [lock] the newest recording job (running or finished), or NULL */
+    char *record_text;                       /* [lock] its newest `recording` message (coalesced: newest wins) */
+    uint32_t record_seq;                     /* [lock] bumped with every new record_text */
     sl_session *next;                        /* [lock] in server->sessions */
     /* [service] */
     sl_client *clients;
@@ -324,6 +356,8 @@ typedef struct sl_server {
     int render_started;
     double start_ms;
     cJSON *techniques_json;                  /* [service] cached list with schemas */
+    char record_dir[64];                     /* recording files, made at start and removed at exit ("" none) */
+    uint32_t next_record_id;                 /* [service] */
 } sl_server;
 
 /* session.c (service thread unless noted) */
@@ -389,6 +423,26 @@ void sl_progress_stage_post(sl_server *srv, sl_session *s, sl_progress_stage sta
 /* Ends the active round with done: ok 1 and the frame that showed the work
  * (its id and render ms), or ok 0 when it ended without one. */
 void sl_progress_end(sl_server *srv, sl_session *s, int ok, double render_ms, uint32_t frame);
+
+/* record.c */
+/* A new job for session s (service thread, s->state as its base): path
+ * checked against the session's technique (sl_scene_path_parse), at most
+ * SL_RECORD_MAX_FRAMES frames and SL_RECORD_MAX_PIXELS, the video size
+ * checked (sl_video_check). SL_ERR_INVALID naming what is wrong. */
+sl_status sl_record_create(sl_server *srv, sl_session *s, const cJSON *path, const char *format, int crf,
+                           sl_record_job **out, sl_err *err);
+/* Frees a job: its writer (render thread, or a finished job) and its file. NULL is fine. */
+void sl_record_free(sl_record_job *j);
+/* Sets the session's newest `recording` text (lock held): the job's id and
+ * state ("queued", "running", "done", "cancelled", "failed") plus the
+ * fields of `extra` (consumed; may be NULL). */
+void sl_record_status_locked(sl_session *s, const sl_record_job *j, const char *state, cJSON *extra);
+/* For GET /recording/KEY?token=T (service thread): 200 with the file path
+ * to serve (the job then gives it up: a second GET is 410), 403 for a
+ * wrong token, 404 for no such finished recording, 410 when it was
+ * downloaded already. */
+int sl_record_take_download(sl_server *srv, const char *key, const char *token, char *file, size_t size,
+                            const char **mime);
 
 /* render.c */
 sl_status sl_render_start(sl_server *srv, sl_err *err);

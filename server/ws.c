@@ -33,6 +33,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <strings.h>
 
 #include <libwebsockets.h>
@@ -280,6 +281,24 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
     }
 }
 
+/* GET /recording/KEY?token=T: a finished recording, once (record.c); the
+ * file is removed as soon as libwebsockets has it open. */
+static int serve_recording(sl_server *srv, struct lws *wsi, const char *key)
+{
+    char arg[96] = "", file[400];
+    const char *mime = NULL;
+    const char *token = lws_get_urlarg_by_name(wsi, "token=", arg, (int)sizeof arg);
+    int status = sl_record_take_download(srv, key, token ? token : "", file, sizeof file, &mime);
+    if (status != 200) {
+        if (lws_return_http_status(wsi, (unsigned)status, NULL))
+            return -1;
+        return lws_http_transaction_completed(wsi) ? -1 : 0;
+    }
+    int rc = lws_serve_http_file(wsi, file, mime, NULL, 0);
+    unlink(file);
+    return rc < 0 ? -1 : 0;
+}
+
 static int callback_http_extras(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
     http_pss *pss = user;
@@ -291,10 +310,12 @@ static int callback_http_extras(struct lws *wsi, enum lws_callback_reasons reaso
     case LWS_CALLBACK_FILTER_HTTP_CONNECTION:
         return filter_http(srv, wsi);
     case LWS_CALLBACK_HTTP: {
-        char uri[32] = "";
+        char uri[96] = "";
         lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI);
         free(pss->body);
         pss->body = NULL;
+        if (strncmp(uri, "/recording/", 11) == 0)
+            return serve_recording(srv, wsi, uri + 11);
         if (strcmp(uri, "/healthz") == 0) {
             pss->body = sl_http_healthz(srv, &pss->status);
             pss->mime = "application/json";
@@ -362,8 +383,12 @@ static const struct lws_protocols protocols[] = {
     {NULL, NULL, 0, 0, 0, NULL, 0},
 };
 
+static struct lws_http_mount mount_recording = {
+    .mountpoint = "/recording", .mountpoint_len = 10, .origin = "http-extras", .origin_protocol = LWSMPRO_CALLBACK,
+};
 static struct lws_http_mount mount_metrics = {
-    .mountpoint = "/metrics", .mountpoint_len = 8, .origin = "http-extras", .origin_protocol = LWSMPRO_CALLBACK,
+    .mount_next = &mount_recording, .mountpoint = "/metrics", .mountpoint_len = 8, .origin = "http-extras",
+    .origin_protocol = LWSMPRO_CALLBACK,
 };
 static struct lws_http_mount mount_healthz = {
     .mount_next = &mount_metrics, .mountpoint = "/healthz", .mountpoint_len = 8, .origin = "http-extras",

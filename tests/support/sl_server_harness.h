@@ -476,8 +476,11 @@ static __attribute__((unused)) int harness_cli_render(const harness *h, const ch
  * "127.0.0.1:port"); the response (headers and body, NUL-terminated,
  * truncated to out_size - 1) goes to out. Returns the HTTP status, or -1
  * when the connection or the request failed (5 s timeout). */
-static __attribute__((unused)) int harness_http_get(int port, const char *host, const char *path, char *out,
-                                                    size_t out_size)
+/* GET path from the server: the whole response (headers and body) into out
+ * (NUL-terminated, so out_size - 1 bytes at most), its length in *len when
+ * len is not NULL. Returns the HTTP status, -1 when unreachable. */
+static __attribute__((unused)) int harness_http_get_n(int port, const char *host, const char *path, char *out,
+                                                      size_t out_size, size_t *len_out)
 {
     out[0] = 0;
     int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -509,7 +512,15 @@ static __attribute__((unused)) int harness_http_get(int port, const char *host, 
     }
     out[len] = 0;
     close(fd);
+    if (len_out)
+        *len_out = len;
     return len >= 12 ? atoi(out + 9) : -1; /* "HTTP/1.1 200" */
+}
+
+static __attribute__((unused)) int harness_http_get(int port, const char *host, const char *path, char *out,
+                                                    size_t out_size)
+{
+    return harness_http_get_n(port, host, path, out, out_size, NULL);
 }
 
 /* hello (new session when session is NULL); fills session/token/client_id. Returns 0 on welcome. */
