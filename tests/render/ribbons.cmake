@@ -167,3 +167,30 @@ endfunction()
 rb_halo(on_silhouette 0 "")
 rb_halo(detects_off 1 "FAIL: column [0-9]+ has a silhouette end without halo" --set params.halo=false)
 rb_halo(detects_inside 1 "FAIL: [0-9]+ halo pixels inside the ribbon" --set params.halo_width=40)
+
+# ---- depth against the analytic elliptic profile (bench plan §5.1's error,
+# as a test): the straight ribbon of straight_edge.vtk seen obliquely
+# (ribbon_oblique.json, data frame, min_pixels 0, halo off, --samples 1),
+# N = 8. ribbons-depth-check (ribbons/ribbons_depth_check.c on
+# tests/support/ribbons_depth_error.h) holds every pixel entering the mantle
+# to [t_ref - 1e-4, t_ref + ribbons_ref_polygon_bound + 1e-4], every pixel
+# through the inscribed cap to 1e-4, and the coverage to the incircle and
+# the profile (1/64 px margin); width_ratio 0.25 and 1. The twin renders
+# width_ratio 0.5 and is judged against the profile of 0.25: it must fail.
+add_executable(ribbons-depth-check ${RIBBONS_DIR}/ribbons_depth_check.c)
+target_link_libraries(ribbons-depth-check PRIVATE sightline_test_support sightline_proto sightline_renderer)
+set_target_properties(ribbons-depth-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+set(RB_DEPTH_CHECK $<TARGET_FILE:ribbons-depth-check>|--scene|${RIBBONS_DIR}/ribbon_oblique.json|--axis|-1,0,0,1,0,0|--normal|0,0,1|--radius|0.1|--sides|8)
+function(rb_depth_test name rendered judged expect_exit)
+  set(extra)
+  if(NOT expect_exit EQUAL 0)
+    set(extra -DEXIT2=${expect_exit} "-DERR2=FAIL: pixel")
+  endif()
+  rb_test(accuracy.analytic_${name} ${CMAKE_COMMAND}
+    "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/ribbon_oblique.json|--out|${RB_OUT}/analytic_${name}.png|--depth|${RB_OUT}/analytic_${name}.pfm|--samples|1|--set|params.width_ratio=${rendered}"
+    "-DSTEP2=${RB_DEPTH_CHECK}|--depth|${RB_OUT}/analytic_${name}.pfm|--width-ratio|${judged}"
+    ${extra} ${SL_STEPS})
+endfunction()
+rb_depth_test(w025_sides8 0.25 0.25 0)
+rb_depth_test(w1_sides8 1 1 0)
+rb_depth_test(detects_wrong_width 0.5 0.25 1)
