@@ -267,8 +267,9 @@ static void print_fig8(const options *o, const char *label, const char *generato
         for (int v = 0; v < VARIANTS; v++) {
             const sl_bench_timing *t = &tb->t[p][v];
             char gpu_cell[32];
+            sl_bench_gpu_cell(t, gpu_cell, sizeof gpu_cell);
             printf("| %s | %s | %.1f (%.1f-%.1f) | %s | %.2f | %.0f | %.1f | %.0f | %.0f |\n", o->pipelines[p],
-                   variant_names[v], t->median_ms, t->min_ms, t->max_ms, sl_bench_gpu_cell(t, gpu_cell, sizeof gpu_cell),
+                   variant_names[v], t->median_ms, t->min_ms, t->max_ms, gpu_cell,
                    ref_ms > 0.0 ? t->median_ms / ref_ms : 0.0, t->primitives, t->gpu_bytes / 1e6, t->prepare_ms,
                    t->peak_rss_mb);
         }
