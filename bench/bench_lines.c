@@ -86,7 +86,7 @@ static sl_status bench_set(sl_gpu *gpu, const line_set *set, int lines, int poin
     const sl_bench_circle circle = {.target = {0, 0, 0}, .radius = 8.0, .fov_y_deg = 45.0};
     const sl_bench_view_spec view = {"circle", sl_bench_circle_camera, &circle};
     sl_bench_peer_files files;
-    st = sl_bench_peer_files_write(generated, 1.0f, &view, 1, o, &files, err);
+    st = sl_bench_peer_files_write(generated, 1.0f, NULL, &view, 1, o, &files, err);
     /* The file's coordinates are the generated world less its origin, and that
      * is the loaded dataset's world: our circle is about the same point. */
     const sl_vec3 shift = generated->origin;

@@ -136,7 +136,8 @@ static sl_status bench_speed(sl_gpu *gpu, const options *o, sl_err *err)
             sl_line_style style;
             sl_line_style_read(&mp0, ds, &style);
             sl_bench_peer_files files;
-            if ((st = sl_bench_peer_files_write(ds, style.radius_scale, views, VIEWS, bo, &files, err)) != SL_OK) {
+            st = sl_bench_peer_files_write(ds, style.radius_scale, NULL, views, VIEWS, bo, &files, err);
+            if (st != SL_OK) {
                 sl_pipeline_destroy(p);
                 return st;
             }

@@ -7,9 +7,9 @@
  * r (1 - cos(pi/n)) head-on and grows towards the silhouettes.
  * 1. Error: one straight tube of radius r seen side-on (no caps), every
  *    pixel's depth against the exact ray-cylinder distance computed here in
- *    double from the camera formula of proto/scene.md (not the renderer's
- *    matrices): max and mean |error| / r over the pixels both hit, max over
- *    pixels hit nearly head-on (incidence cosine >= 0.9) next to the bound,
+ *    double on the rays of proto/scene.md (tests/support/ref_camera.h, not
+ *    the renderer's matrices): max and mean |error| / r over the pixels both
+ *    hit, max over pixels hit nearly head-on (incidence cosine >= 0.9) next to the bound,
  *    and coverage mismatch.
  * 2. Time through the harness (bench/harness/sl_bench.h: wall ms to glFinish
  *    after the readback, an orbit of N frames after a warm-up, default
@@ -30,6 +30,7 @@
 #include "gpu/sl_gpu.h"
 #include "pipeline/sl_pipeline.h"
 #include "harness/sl_bench.h"
+#include "ref_camera.h"
 
 #define MAX_SIDES 16
 
@@ -151,30 +152,18 @@ static sl_status measure_error(sl_gpu *gpu, const options *o, int sides, error_r
         (st = set_technique(p, sides, err)) == SL_OK && (st = sl_pipeline_render(p, &view, 1, &stats, err)) == SL_OK)
         sl_pipeline_read_distance(p, &view, dist);
     if (st == SL_OK) {
-        /* The reference camera, built here from the scene.md formula. */
-        double f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]}, up[3] = {0, 1, 0};
-        double fl = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-        for (int k = 0; k < 3; k++)
-            f[k] /= fl;
-        double r[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]};
-        double rl = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-        for (int k = 0; k < 3; k++)
-            r[k] /= rl;
-        double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
-        double th = tan(fov * M_PI / 360.0), aspect = (double)o->width / o->height;
+        /* The reference camera: proto/scene.md's rays in double (tests/support/ref_camera.h). */
+        const double up[3] = {0, 1, 0};
+        ref_camera cam;
+        if (ref_camera_init(&cam, eye, target, up, fov, o->width, o->height) != 0)
+            st = sl_err_set(err, SL_ERR_INVALID, "degenerate reference camera");
         double sum = 0.0;
         size_t mismatch = 0, hits = 0;
         *row = (error_row){0};
-        for (int j = 0; j < o->height; j++)
+        for (int j = 0; st == SL_OK && j < o->height; j++)
             for (int i = 0; i < o->width; i++) {
-                double sx = (2.0 * (i + 0.5) / o->width - 1.0) * th * aspect, sy = (1.0 - 2.0 * (j + 0.5) / o->height) * th;
-                double d[3], dl = 0.0;
-                for (int k = 0; k < 3; k++) {
-                    d[k] = f[k] + sx * r[k] + sy * u[k];
-                    dl += d[k] * d[k];
-                }
-                for (int k = 0; k < 3; k++)
-                    d[k] /= sqrt(dl);
+                double d[3];
+                ref_camera_ray(&cam, i, j, d);
                 double cos_in = 0.0, t_ref = cylinder_hit(eye, d, TUBE_RADIUS, TUBE_HALF_LENGTH, &cos_in);
                 double t_gpu = dist[(size_t)j * o->width + i];
                 int ref_hit = t_ref > 0.0, gpu_hit = t_gpu > 0.0;

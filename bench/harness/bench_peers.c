@@ -5,7 +5,8 @@
  * very cameras sl_bench_time_frames renders) in a temporary folder; each peer
  * program reads both and prints one JSON line ({"ok": true, "views": {VIEW:
  * {"median_ms", "min_ms", "max_ms"}}, ...} or {"ok": false, "error"}):
- * bench/vtk_tubes.py under xvfb-run (Debian's VTK is X11-only) and
+ * bench/vtk_tubes.py and bench/vtk_ribbons.py under xvfb-run (Debian's VTK
+ * is X11-only; the lines file then also carries the ribbons' NORMALS) and
  * peer-embree-tubes (bench/peers/, next to the running program). A peer that
  * is missing or fails gives ok = 0 and a reason for the table, never a crash.
  * Main thread; runs child processes through popen.
@@ -40,7 +41,8 @@ static void put_be_float(float x, FILE *f)
     put_be32(v, f);
 }
 
-sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, const char *path, sl_err *err)
+sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, const float *normals, const char *path,
+                                   sl_err *err)
 {
     if (ds->kind != SL_DATASET_LINES)
         return sl_err_set(err, SL_ERR_INVALID, "%s is not a line set", ds->name);
@@ -63,10 +65,19 @@ sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, con
         for (uint32_t i = l->line_offsets[k]; i < l->line_offsets[k + 1]; i++)
             put_be32(i, f);
     }
+    if (l->radii || normals)
+        fprintf(f, "\nPOINT_DATA %zu\n", l->vertex_count);
     if (l->radii) {
-        fprintf(f, "\nPOINT_DATA %zu\nSCALARS radius float 1\nLOOKUP_TABLE default\n", l->vertex_count);
+        fprintf(f, "SCALARS radius float 1\nLOOKUP_TABLE default\n");
         for (size_t k = 0; k < l->vertex_count; k++)
             put_be_float(l->radii[k] * radius_scale, f);
+        if (normals)
+            fputc('\n', f);
+    }
+    if (normals) {
+        fprintf(f, "NORMALS normals float\n");
+        for (size_t k = 0; k < 3 * l->vertex_count; k++)
+            put_be_float(normals[k], f);
     }
     fputc('\n', f);
     int bad = ferror(f);
@@ -75,9 +86,9 @@ sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, con
     return SL_OK;
 }
 
-sl_status sl_bench_peer_files_write(const sl_dataset *ds, float radius_scale, const sl_bench_view_spec *views,
-                                    int view_count, const sl_bench_options *o, sl_bench_peer_files *files,
-                                    sl_err *err)
+sl_status sl_bench_peer_files_write(const sl_dataset *ds, float radius_scale, const float *normals,
+                                    const sl_bench_view_spec *views, int view_count, const sl_bench_options *o,
+                                    sl_bench_peer_files *files, sl_err *err)
 {
     memset(files, 0, sizeof *files);
     snprintf(files->dir, sizeof files->dir, "/tmp/sightline-bench-XXXXXX");
@@ -87,7 +98,7 @@ sl_status sl_bench_peer_files_write(const sl_dataset *ds, float radius_scale, co
     }
     snprintf(files->lines, sizeof files->lines, "%s/lines.vtk", files->dir);
     snprintf(files->cameras, sizeof files->cameras, "%s/cameras.txt", files->dir);
-    sl_status st = sl_bench_write_lines_vtk(ds, radius_scale, files->lines, err);
+    sl_status st = sl_bench_write_lines_vtk(ds, radius_scale, normals, files->lines, err);
     FILE *f = st == SL_OK ? fopen(files->cameras, "w") : NULL;
     if (st == SL_OK && !f)
         st = sl_err_set(err, SL_ERR_IO, "cannot write %s", files->cameras);
@@ -221,6 +232,7 @@ static void run_peer(const char *cmd, const sl_bench_tube_peer_desc *d, const ch
         r->build_ms = json_number(root, cJSON_GetObjectItemCaseSensitive(root, "filter_ms") ? "filter_ms" : "build_ms");
         r->first_frame_ms = json_number(root, "first_frame_ms");
         r->triangles = json_number(root, "triangles");
+        r->mesh_bytes = json_number(root, "mesh_bytes");
         json_string(root, "gl_renderer", r->renderer, sizeof r->renderer);
         json_string(root, cJSON_GetObjectItemCaseSensitive(root, "vtk") ? "vtk" : "embree", r->version,
                     sizeof r->version);
@@ -239,31 +251,52 @@ static void run_peer(const char *cmd, const sl_bench_tube_peer_desc *d, const ch
     cJSON_Delete(root);
 }
 
-void sl_bench_peer_vtk_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r)
+/* The start of a VTK peer's command line: xvfb-run, /usr/bin/python3 and
+ * bench/<script> with the files and the size; 1, or 0 with r->reason set. */
+static int vtk_command(const char *script_name, const sl_bench_tube_peer_desc *d, char *cmd, size_t size,
+                       sl_bench_peer_result *r)
 {
     memset(r, 0, sizeof *r);
     const char *src = getenv("SIGHTLINE_SOURCE_DIR");
     char script[4096], reason[600];
-    snprintf(script, sizeof script, "%s/bench/vtk_tubes.py", src && *src ? src : SIGHTLINE_SOURCE_DIR);
+    snprintf(script, sizeof script, "%s/bench/%s", src && *src ? src : SIGHTLINE_SOURCE_DIR, script_name);
     if (access(script, R_OK) != 0) {
         snprintf(reason, sizeof reason, "no %.400s; set SIGHTLINE_SOURCE_DIR", script);
         set_reason(r, reason);
-        return;
+        return 0;
     }
     if (access("/usr/bin/python3", X_OK) != 0 || !executable_on_path("xvfb-run")) {
         set_reason(r, "no /usr/bin/python3 or xvfb-run; scripts/bench installs bench/packages.txt");
-        return;
+        return 0;
     }
     const sl_bench_options *o = d->options;
-    char cmd[16384];
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 %dx%dx24' /usr/bin/python3 ", o->width > 1280 ? o->width : 1280,
+    snprintf(cmd, size, "xvfb-run -a -s '-screen 0 %dx%dx24' /usr/bin/python3 ", o->width > 1280 ? o->width : 1280,
              o->height > 1024 ? o->height : 1024);
-    append_quoted(cmd, sizeof cmd, script);
-    append_files(cmd, sizeof cmd, d->files);
+    append_quoted(cmd, size, script);
+    append_files(cmd, size, d->files);
     size_t n = strlen(cmd);
-    snprintf(cmd + n, sizeof cmd - n, " --size %dx%d --radius %.9g --sides %d --caps %d 2>&1", o->width, o->height,
-             d->radius, d->sides, d->caps);
+    snprintf(cmd + n, size - n, " --size %dx%d", o->width, o->height);
+    return 1;
+}
+
+void sl_bench_peer_vtk_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r)
+{
+    char cmd[16384];
+    if (!vtk_command("vtk_tubes.py", d, cmd, sizeof cmd, r))
+        return;
+    size_t n = strlen(cmd);
+    snprintf(cmd + n, sizeof cmd - n, " --radius %.9g --sides %d --caps %d 2>&1", d->radius, d->sides, d->caps);
     run_peer(cmd, d, "vtk_tubes.py", r);
+}
+
+void sl_bench_peer_vtk_ribbons(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r)
+{
+    char cmd[16384];
+    if (!vtk_command("vtk_ribbons.py", d, cmd, sizeof cmd, r))
+        return;
+    size_t n = strlen(cmd);
+    snprintf(cmd + n, sizeof cmd - n, " --width %.9g 2>&1", d->radius);
+    run_peer(cmd, d, "vtk_ribbons.py", r);
 }
 
 void sl_bench_peer_embree_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r)

@@ -106,15 +106,17 @@ typedef struct sl_bench_view_spec {
 } sl_bench_view_spec;
 
 /* Writes ds's lines (radii times radius_scale as the point scalar, when the
- * data has radii) and the cameras of every view (warm-up + o->frames each,
- * the very cameras sl_bench_time_frames uses) into a new temporary folder. */
-sl_status sl_bench_peer_files_write(const sl_dataset *ds, float radius_scale, const sl_bench_view_spec *views,
-                                    int view_count, const sl_bench_options *o, sl_bench_peer_files *files,
-                                    sl_err *err);
+ * data has radii; normals, 3 floats per vertex, as the point NORMALS when not
+ * NULL) and the cameras of every view (warm-up + o->frames each, the very
+ * cameras sl_bench_time_frames uses) into a new temporary folder. */
+sl_status sl_bench_peer_files_write(const sl_dataset *ds, float radius_scale, const float *normals,
+                                    const sl_bench_view_spec *views, int view_count, const sl_bench_options *o,
+                                    sl_bench_peer_files *files, sl_err *err);
 void sl_bench_peer_files_remove(sl_bench_peer_files *files); /* removes the folder; safe twice */
 
 /* Writes the lines alone (also used to give our own loader the peers' file). */
-sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, const char *path, sl_err *err);
+sl_status sl_bench_write_lines_vtk(const sl_dataset *ds, float radius_scale, const float *normals, const char *path,
+                                   sl_err *err);
 
 typedef struct sl_bench_peer_result {
     int ok;
@@ -122,7 +124,8 @@ typedef struct sl_bench_peer_result {
     double median_ms[SL_BENCH_MAX_VIEWS], min_ms[SL_BENCH_MAX_VIEWS], max_ms[SL_BENCH_MAX_VIEWS];
     double build_ms;                    /* VTK: tube filter; Embree: BVH build */
     double first_frame_ms;              /* VTK: the first frame, which uploads the mesh */
-    double triangles;                   /* VTK: tube triangles */
+    double triangles;                   /* VTK: tube or ribbon triangles */
+    double mesh_bytes;                  /* VTK: the filter output's memory (vtkDataObject::GetActualMemorySize) */
     double seconds;                     /* the whole run, start-up included */
     char version[32], renderer[128];
 } sl_bench_peer_result;
@@ -132,7 +135,7 @@ typedef struct sl_bench_tube_peer_desc {
     const sl_bench_view_spec *views;
     int view_count;
     const sl_bench_options *options;
-    double radius;        /* radius where the file has none */
+    double radius;        /* radius where the file has none; ribbons: the half-width */
     int sides, caps;      /* VTK tube filter: tubes_mesh's defaults */
     int threads;          /* Embree: worker threads (the machine's cores) */
 } sl_bench_tube_peer_desc;
@@ -140,6 +143,10 @@ typedef struct sl_bench_tube_peer_desc {
 /* VTK's vtkTubeFilter + vtkPolyDataMapper (bench/vtk_tubes.py under xvfb-run,
  * on the same GL); fills r, r->ok = 0 with a reason when it cannot run. */
 void sl_bench_peer_vtk_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r);
+/* VTK's vtkRibbonFilter (flat ribbons, Width = d->radius, oriented by the
+ * file's NORMALS, else VTK's default normals) + vtkPolyDataMapper
+ * (bench/vtk_ribbons.py under xvfb-run); sides, caps and threads unused. */
+void sl_bench_peer_vtk_ribbons(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r);
 /* Embree 3 round Hermite curves on the CPU (bench/peers/embree_tubes.c,
  * built as peer-embree-tubes next to this program when Embree is installed). */
 void sl_bench_peer_embree_tubes(const sl_bench_tube_peer_desc *d, sl_bench_peer_result *r);

@@ -218,8 +218,7 @@ rb_test(twist.detects_uncorrected ${CMAKE_COMMAND}
   "-DSTEP3=${RB_TWIST_CHECK}|--png|${RB_OUT}/twist_70_as_0.png|--reference|${RB_OUT}/twist_ref_70_as_0.png|--alpha-deg|0"
   -DEXIT3=1 "-DERR3=FAIL: stripe width [0-9.]+, want 0.4000"
   ${SL_STEPS})
-# ======================================================================
-# ---- pipelines (plan §3.3): geometry, mesh and flat against pulling.
+# ===============================================================# ---- pipelines (plan §3.3): geometry, mesh and flat against pulling.
 # Same image: geometry-shader extrusion and the static mesh place the same
 # vertices (ribbons_vertex.glsl) and share the fragment shader, so against
 # pulling on tornado (halo on, 3 twist lines) and the helix (helicity frame,
@@ -330,3 +329,30 @@ foreach(pipeline geometry mesh flat)
     "-DSTEP2=${RB_IMAGE}|--scene|${RIBBONS_DIR}/stress.json|--png|${RB_OUT}/stress_${pipeline}.png|--depth|${RB_OUT}/stress_${pipeline}.pfm|--min-color-pct|3|--min-hit-pct|3"
     ${SL_STEPS})
 endforeach()
+=======
+# ---- depth against the analytic elliptic profile (bench plan §5.1's error,
+# as a test): the straight ribbon of straight_edge.vtk seen obliquely
+# (ribbon_oblique.json, data frame, min_pixels 0, halo off, --samples 1),
+# N = 8. ribbons-depth-check (ribbons/ribbons_depth_check.c on
+# tests/support/ribbons_depth_error.h) holds every pixel entering the mantle
+# to [t_ref - 1e-4, t_ref + ribbons_ref_polygon_bound + 1e-4], every pixel
+# through the inscribed cap to 1e-4, and the coverage to the incircle and
+# the profile (1/64 px margin); width_ratio 0.25 and 1. The twin renders
+# width_ratio 0.5 and is judged against the profile of 0.25: it must fail.
+add_executable(ribbons-depth-check ${RIBBONS_DIR}/ribbons_depth_check.c)
+target_link_libraries(ribbons-depth-check PRIVATE sightline_test_support sightline_proto sightline_renderer)
+set_target_properties(ribbons-depth-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+set(RB_DEPTH_CHECK $<TARGET_FILE:ribbons-depth-check>|--scene|${RIBBONS_DIR}/ribbon_oblique.json|--axis|-1,0,0,1,0,0|--normal|0,0,1|--radius|0.1|--sides|8)
+function(rb_depth_test name rendered judged expect_exit)
+  set(extra)
+  if(NOT expect_exit EQUAL 0)
+    set(extra -DEXIT2=${expect_exit} "-DERR2=FAIL: pixel")
+  endif()
+  rb_test(accuracy.analytic_${name} ${CMAKE_COMMAND}
+    "-DSTEP1=${RB_RENDER}|--scene|${RIBBONS_DIR}/ribbon_oblique.json|--out|${RB_OUT}/analytic_${name}.png|--depth|${RB_OUT}/analytic_${name}.pfm|--samples|1|--set|params.width_ratio=${rendered}"
+    "-DSTEP2=${RB_DEPTH_CHECK}|--depth|${RB_OUT}/analytic_${name}.pfm|--width-ratio|${judged}"
+    ${extra} ${SL_STEPS})
+endfunction()
+rb_depth_test(w025_sides8 0.25 0.25 0)
+rb_depth_test(w1_sides8 1 1 0)
+rb_depth_test(detects_wrong_width 0.5 0.25 1)
