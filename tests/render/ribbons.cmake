@@ -329,7 +329,6 @@ foreach(pipeline geometry mesh flat)
     "-DSTEP2=${RB_IMAGE}|--scene|${RIBBONS_DIR}/stress.json|--png|${RB_OUT}/stress_${pipeline}.png|--depth|${RB_OUT}/stress_${pipeline}.pfm|--min-color-pct|3|--min-hit-pct|3"
     ${SL_STEPS})
 endforeach()
-=======
 # ---- depth against the analytic elliptic profile (bench plan §5.1's error,
 # as a test): the straight ribbon of straight_edge.vtk seen obliquely
 # (ribbon_oblique.json, data frame, min_pixels 0, halo off, --samples 1),
