@@ -215,7 +215,7 @@ static void check_case(const options *o, const regress_suite *s, const regress_c
         if (!file_exists(golden)) {
             if (!o->update) {
                 r->outcome = REGRESS_FAIL;
-                snprintf(r->message, sizeof r->message, "no golden %s (run with --update to make it)", golden);
+                snprintf(r->message, sizeof r->message, "no golden %.440s (run with --update to make it)", golden);
                 return;
             }
             created = 1;
@@ -225,7 +225,7 @@ static void check_case(const options *o, const regress_suite *s, const regress_c
         const char *fails = NULL;
         if (!created && compare_colour(c, golden, fresh, &d, &heat, &fails, &err) != SL_OK) {
             r->outcome = REGRESS_ERROR;
-            snprintf(r->message, sizeof r->message, "frame %d: %s", f, err.message);
+            snprintf(r->message, sizeof r->message, "frame %d: %.480s", f, err.message);
             free(heat);
             return;
         }
@@ -235,7 +235,7 @@ static void check_case(const options *o, const regress_suite *s, const regress_c
                 changed |= !created;
                 if (copy_png(fresh, golden, &err) != SL_OK) {
                     r->outcome = REGRESS_ERROR;
-                    snprintf(r->message, sizeof r->message, "%s", err.message);
+                    snprintf(r->message, sizeof r->message, "%.500s", err.message);
                     return;
                 }
             }
@@ -281,19 +281,19 @@ static void check_case(const options *o, const regress_suite *s, const regress_c
                 changed = 1;
             if (!same && copy_pfm(fresh, golden, &err) != SL_OK) {
                 r->outcome = REGRESS_ERROR;
-                snprintf(r->message, sizeof r->message, "%s", err.message);
+                snprintf(r->message, sizeof r->message, "%.500s", err.message);
                 return;
             }
         } else if (!file_exists(golden)) {
             r->outcome = REGRESS_FAIL;
-            snprintf(r->message, sizeof r->message, "no golden %s (run with --update to make it)", golden);
+            snprintf(r->message, sizeof r->message, "no golden %.440s (run with --update to make it)", golden);
             return;
         } else {
             sl_diff_result d = {0};
             const char *fails = NULL;
             if (compare_depth(c, golden, fresh, &d, &fails, &err) != SL_OK) {
                 r->outcome = REGRESS_ERROR;
-                snprintf(r->message, sizeof r->message, "depth: %s", err.message);
+                snprintf(r->message, sizeof r->message, "depth: %.490s", err.message);
                 return;
             }
             r->depth_mean = d.mean_abs;

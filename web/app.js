@@ -2,7 +2,8 @@
 // canvas with createImageBitmap (interactive frames, smaller, stretched to the
 // canvas), acks them, wires camera input (camera.js),
 // schema-generated parameter controls (controls.js), dataset/technique
-// pickers, views, snapshots, sharing, control requests, the progress bar of
+// pickers, views, snapshots, sharing, control requests, camera keyframes
+// recorded into a video on the server (flight.js), the progress bar of
 // long loads and prepares (progress.js) and the status line (fps, latency,
 // size, and the load, prepare, render and encode ms separately).
 // The session id and token live in the URL fragment (#session=..&token=..),
@@ -14,6 +15,7 @@ import { Connection } from './protocol.js';
 import { CameraControl } from './camera.js';
 import { ParamControls } from './controls.js';
 import { ProgressOverlay } from './progress.js';
+import { FlightPanel } from './flight.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
@@ -66,7 +68,13 @@ window.sightline = {
   get connected() { return conn.ws?.readyState === WebSocket.OPEN; },
   get progressStage() { return progress.stage; },
   get timings() { return progress.timings; },
+  get recording() { return flight.lastJob; },
 };
+const flight = new FlightPanel($('flight'), {
+  send: (msg) => conn.send(msg),
+  token: () => conn.token,
+  camera: () => app.state?.camera,
+});
 
 const camera = new CameraControl(canvas, (phase, cam) => {
   const seq = ++app.seq;
@@ -311,6 +319,9 @@ conn.addEventListener('message', (ev) => {
     case 'progress':
       progress.update(msg);
       break;
+    case 'recording':
+      flight.update(msg);
+      break;
     case 'error':
       if (msg.code === 'load_failed') progress.hide();
       if (msg.field === 'dataset' || msg.field === 'technique') fillPickers();   // back to the session's pair
@@ -380,15 +391,16 @@ new ResizeObserver(() => {
   resizeTimer = setTimeout(() => {
     if (!isController()) return;
     const stage = $('stage');
-    const w = Math.max(64, Math.min(1920, Math.round(stage.clientWidth)));
-    const h = Math.max(48, Math.min(1080, Math.round(stage.clientHeight)));
+    // Even sizes: a recording's video (4:2:0 colour) needs them.
+    const w = Math.max(64, Math.min(1920, Math.round(stage.clientWidth))) & ~1;
+    const h = Math.max(48, Math.min(1080, Math.round(stage.clientHeight))) & ~1;
     if (app.state && (w !== app.state.width || h !== app.state.height)) conn.send({ type: 'resize', width: w, height: h });
   }, 250);
 }).observe($('stage'));
 
 {
   const stage = $('stage');
-  conn.width = Math.max(64, Math.min(1920, Math.round(stage.clientWidth || 640)));
-  conn.height = Math.max(48, Math.min(1080, Math.round(stage.clientHeight || 480)));
+  conn.width = Math.max(64, Math.min(1920, Math.round(stage.clientWidth || 640))) & ~1;
+  conn.height = Math.max(48, Math.min(1080, Math.round(stage.clientHeight || 480))) & ~1;
 }
 conn.open();

@@ -260,6 +260,35 @@ async function driveControls(page, obs, sess, saved) {
   check((await banner()) === '', `no error on ribbons (${await banner()})`);
   await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-ribbons.png') });
 
+  // Flight: two keyframes (the view, then the view after a drag), recorded
+  // at 4 frames per second into an MP4 on the server; progress reaches the
+  // page, the download link fetches the video once (a second fetch is 410).
+  await page.click('#flight .add-key');
+  const box0 = await page.locator('#view').boundingBox();
+  await page.mouse.move(box0.x + box0.width / 2, box0.y + box0.height / 2);
+  await page.mouse.down();
+  for (let i = 1; i <= 8; i++) await page.mouse.move(box0.x + box0.width / 2 + 12 * i, box0.y + box0.height / 2);
+  await page.mouse.up();
+  await settled(page);
+  await page.click('#flight .add-key');
+  check((await page.$$eval('#flight .keys .key', (ks) => ks.length)) === 2, 'two keyframes listed');
+  await page.fill('#flight .fps', '4');
+  await page.click('#flight .record');
+  await page.waitForFunction(() => ['done', 'failed', 'cancelled'].includes(window.sightline.recording?.state), null,
+    { timeout: 60000 });
+  const job = await page.evaluate(() => window.sightline.recording);
+  check(job.state === 'done' && job.frames === 9, `the flight recorded: ${job.state}, ${job.frames} frames (${job.message || ''})`);
+  const fetched = await page.evaluate(async () => {
+    const href = document.querySelector('#flight .record-link').href;
+    const r1 = await fetch(href);
+    const body = await r1.arrayBuffer();
+    const r2 = await fetch(href);
+    return { first: r1.status, type: r1.headers.get('content-type'), bytes: body.byteLength, second: r2.status };
+  });
+  check(fetched.first === 200 && fetched.type === 'video/mp4' && fetched.bytes > 1000 && fetched.second === 410,
+    `the download link: ${JSON.stringify(fetched)}`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-flight.png') });
+
   // Technique picker: the server switches, the controls follow the new schema.
   const tech = 'tubes';
   await page.selectOption('#technique', tech);

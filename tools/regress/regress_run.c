@@ -64,7 +64,7 @@ static pid_t start(const regress_case *c, const char *render_exe, const char *ou
     int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd < 0) {
         r->outcome = REGRESS_ERROR;
-        snprintf(r->message, sizeof r->message, "cannot write the log %s: %s", log, strerror(errno));
+        snprintf(r->message, sizeof r->message, "cannot write the log %.400s: %.80s", log, strerror(errno));
         return -1;
     }
     fflush(NULL);
@@ -97,7 +97,7 @@ static void last_log_line(const char *out_dir, const char *name, char *line, siz
     while (fgets(buf, sizeof buf, f))
         if (buf[0] && buf[0] != '\n' && strncmp(buf, "sightline: OpenGL renderer", 26) != 0) {
             buf[strcspn(buf, "\n")] = '\0';
-            snprintf(line, size, "%s", buf);
+            snprintf(line, size, "%.390s", buf);
         }
     fclose(f);
 }
