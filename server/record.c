@@ -18,22 +18,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/random.h>
 #include <unistd.h>
 
 #include "core/sl_technique.h"
 #include "image/sl_video.h"
 #include "sl_scene_path.h"
-
-static void random_key(char out[33])
-{
-    unsigned char b[16];
-    if (getrandom(b, sizeof b, 0) != (ssize_t)sizeof b)
-        for (size_t i = 0; i < sizeof b; i++)
-            b[i] = (unsigned char)(rand() ^ (int)(sl_clock_ms() * 1000.0) >> (i % 8));
-    for (size_t i = 0; i < sizeof b; i++)
-        snprintf(out + 2 * i, 3, "%02x", b[i]);
-}
 
 sl_status sl_record_create(sl_server *srv, sl_session *s, const cJSON *path, const char *format, int crf,
                            sl_record_job **out, sl_err *err)
@@ -67,7 +56,7 @@ sl_status sl_record_create(sl_server *srv, sl_session *s, const cJSON *path, con
     j->frames = frames;
     j->crf = crf;
     snprintf(j->format, sizeof j->format, "%s", format);
-    random_key(j->key);
+    sl_random_hex(j->key, 16);
     snprintf(j->file, sizeof j->file, "%s/%s-%u.%s", srv->record_dir, s->id, j->id, format);
     st = sl_video_check(&(sl_video_desc){j->file, s->state.width, s->state.height, p->fps, crf}, err);
     if (st != SL_OK) {

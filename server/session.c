@@ -34,7 +34,7 @@
 #include "sl_params_json.h"
 #include "sl_scene.h"
 
-static void random_hex(char *out, int bytes)
+void sl_random_hex(char *out, int bytes)
 {
     unsigned char buf[32];
     if (getrandom(buf, (size_t)bytes, 0) != bytes) {
@@ -242,8 +242,8 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
         sl_err_set(err, SL_ERR_NOMEM, "session allocation failed");
         return NULL;
     }
-    random_hex(s->id, 8);
-    random_hex(s->token, 16);
+    sl_random_hex(s->id, 8);
+    sl_random_hex(s->token, 16);
     int tc = 0;
     const sl_technique *const *techs = sl_technique_list(&tc);
     sl_session_state *st = &s->state;

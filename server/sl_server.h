@@ -367,6 +367,9 @@ void sl_sessions_on_wake(sl_server *srv);     /* dispatch frames, snapshots, err
 void sl_sessions_sweep(sl_server *srv);       /* expire sessions past the grace period */
 void sl_sessions_destroy_all(sl_server *srv); /* at shutdown, after the render thread ended */
 void sl_session_free(sl_session *s);          /* render thread or shutdown; after its scene and load were released */
+/* 2 x bytes lowercase hex digits of getrandom (bytes <= 32) and a NUL into
+ * out: session ids, tokens, recording keys. Any thread. */
+void sl_random_hex(char *out, int bytes);
 /* Queues a text message for c (takes ownership of text). Returns -1 when the
  * client's queue is full (the client is then closed). */
 int sl_client_queue_text(sl_client *c, char *text);

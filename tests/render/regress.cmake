@@ -7,7 +7,9 @@
 # unchanged") and the next run passes again. A suite of a path (3 frames, one
 # golden a frame) and a still case with a depth check round-trips from empty
 # goldens (a first run fails: "no golden"). A suite whose expect file has a
-# typo is refused with exit 2.
+# typo, or one that belongs to no case, is refused with exit 2. The tubes_mesh
+# goldens (tests/render/tubes_mesh/goldens) are cases that name a scene of
+# that folder and --set overrides in their expect files.
 set(RG_OUT ${SL_RENDER_OUT}/regress)
 set(RG_REGRESS $<TARGET_FILE:sightline-regress>)
 set(RG_SRC ${CMAKE_CURRENT_SOURCE_DIR})
@@ -47,4 +49,9 @@ sl_add_render_test(NAME regress.path_round_trip COMMAND ${CMAKE_COMMAND}
 sl_add_render_test(NAME regress.bad_suite COMMAND ${CMAKE_COMMAND}
   "-DSTEP1=${RG_REGRESS}|${RG_SRC}/regress/bad_suite|--out|${RG_OUT}/bad"
   -DEXIT1=2 "-DERR1=tiny.expect.json: max_meen: unknown field"
+  ${SL_STEPS})
+# An expect file that is no case's (no NAME.json beside it, no "scene") is refused too.
+sl_add_render_test(NAME regress.orphan_expect COMMAND ${CMAKE_COMMAND}
+  "-DSTEP1=${RG_REGRESS}|${RG_SRC}/regress/orphan_suite|--out|${RG_OUT}/orphan"
+  -DEXIT1=2 "-DERR1=lost.expect.json has no case lost.json and names no scene"
   ${SL_STEPS})

@@ -44,37 +44,28 @@ tm_test(smoke.tornado ${CMAKE_COMMAND}
   "-DSTEP2=${TM_CHECK}|image|--scene|${TM_DIR}/tornado.json|--png|${TM_OUT}/smoke.png|--depth|${TM_OUT}/smoke.pfm|--min-color-pct|10|--min-hit-pct|10"
   ${TM_STEPS})
 
-# ---- 2. golden images (sightline-render defaults: 4x MSAA). Regenerate after a
-# deliberate change, look at it, and say so in the commit:
-#   sightline-render --scene tests/render/tubes_mesh/S.json [--set ...] --out tests/render/tubes_mesh/golden/NAME.png
+# ---- 2. golden images: the suite tests/render/tubes_mesh/goldens through
+# sightline-regress (sightline-render defaults: 4x MSAA; each case is an
+# expect file naming a scene of this folder and its --set overrides):
 #   tornado:        colormap (viridis) on the speed attribute, constant radius, 12 sides, caps
 #   hotroom:        per-vertex data radii x radius_scale 0.7, coolwarm on temperature, 16 sides
 #   caps_sides6:    one tube, 6 sides, flat caps in view (plasma along the tube)
 #   open_sides6:    the same without caps: the inner wall through the open end
 #   degenerate_obj: degenerate.obj (repeated points, reversals) in a constant colour
-function(tm_golden name scene)
-  string(REPLACE ";" "|" sets "${ARGN}")
-  if(sets)
-    set(sets "|${sets}")
-  endif()
-  tm_test(golden.${name} ${CMAKE_COMMAND}
-    "-DSTEP1=${TM_RENDER}|--scene|${TM_DIR}/${scene}|--out|${TM_OUT}/golden_${name}.png${sets}"
-    "-DSTEP2=${TM_DIFF}|${TM_OUT}/golden_${name}.png|${TM_DIR}/golden/${name}.png|${TM_GOLDEN_ARGS}|--diff|${TM_OUT}/golden_${name}_heat.png"
-    ${TM_STEPS})
-endfunction()
-tm_golden(tornado tornado.json)
-tm_golden(hotroom hotroom.json)
-tm_golden(caps_sides6 cylinder_oblique.json --set params.sides=6)
-tm_golden(open_sides6 cylinder_oblique.json --set params.sides=6 --set params.caps=false)
-tm_golden(degenerate_obj degenerate_obj.json)
+# After a deliberate change: sightline-regress tests/render/tubes_mesh/goldens
+# --update, look at the new goldens, and say so in the commit.
+tm_test(goldens ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-regress>|${TM_DIR}/goldens|--out|${TM_OUT}/goldens|--jobs|2|--junit|${TM_OUT}/goldens.xml"
+  "-DOUT1=5 cases, 5 passed, 0 failed, 0 errors"
+  ${TM_STEPS})
 # The limits catch a uniform error: +5 on every drawn pixel of the
 # degenerate_obj golden (7 % of the frame drawn) is a covered mean of 5, over
 # 0.5; over the whole frame it was 0.35 and passed (step 2 shows it).
 tm_test(golden.detects_uniform_error ${CMAKE_COMMAND}
-  "-DSTEP1=$<TARGET_FILE:golden-offset>|${TM_DIR}/golden/degenerate_obj.png|${TM_OUT}/golden_plus5.png|26,26,31|5"
-  "-DSTEP2=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/golden/degenerate_obj.png|--max-mean|0.5|--max-bad-pct|0.5|--bad-threshold|16"
+  "-DSTEP1=$<TARGET_FILE:golden-offset>|${TM_DIR}/goldens/golden/degenerate_obj.png|${TM_OUT}/golden_plus5.png|26,26,31|5"
+  "-DSTEP2=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/goldens/golden/degenerate_obj.png|--max-mean|0.5|--max-bad-pct|0.5|--bad-threshold|16"
   "-DOUT2=\"pass\":[ \t]*true"
-  "-DSTEP3=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/golden/degenerate_obj.png|${TM_GOLDEN_ARGS}"
+  "-DSTEP3=${TM_DIFF}|${TM_OUT}/golden_plus5.png|${TM_DIR}/goldens/golden/degenerate_obj.png|${TM_GOLDEN_ARGS}"
   -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_mean\"\\]"
   ${TM_STEPS})
 
@@ -181,13 +172,13 @@ tm_test(cli.stats ${CMAKE_COMMAND}
 # fail with exit 1 (a limit exceeded), not 2 (bad input).
 tm_test(cli.set_changes_image ${CMAKE_COMMAND}
   "-DSTEP1=${TM_RENDER}|--scene|${TM_DIR}/tornado.json|--out|${TM_OUT}/azimuth30.png|--set|camera.orbit.azimuth=30"
-  "-DSTEP2=${TM_DIFF}|${TM_OUT}/azimuth30.png|${TM_DIR}/golden/tornado.png|${TM_GOLDEN_ARGS}"
+  "-DSTEP2=${TM_DIFF}|${TM_OUT}/azimuth30.png|${TM_DIR}/goldens/golden/tornado.png|${TM_GOLDEN_ARGS}"
   -DEXIT2=1 "-DOUT2=\"pass\":[ \t]*false"
   ${TM_STEPS})
 # The same for a parameter: another colormap.
 tm_test(cli.set_param_changes_image ${CMAKE_COMMAND}
   "-DSTEP1=${TM_RENDER}|--scene|${TM_DIR}/tornado.json|--out|${TM_OUT}/magma.png|--set|params.colormap=magma"
-  "-DSTEP2=${TM_DIFF}|${TM_OUT}/magma.png|${TM_DIR}/golden/tornado.png|${TM_GOLDEN_ARGS}"
+  "-DSTEP2=${TM_DIFF}|${TM_OUT}/magma.png|${TM_DIR}/goldens/golden/tornado.png|${TM_GOLDEN_ARGS}"
   -DEXIT2=1 "-DOUT2=\"pass\":[ \t]*false"
   ${TM_STEPS})
 # A .jpg output is a JPEG that decodes to the PNG's picture.
@@ -248,7 +239,7 @@ tm_test(selftest.stats_detects_bad_file ${CMAKE_COMMAND}
 # A JPEG that does not show the PNG's picture.
 tm_test(selftest.jpeg_detects_other_picture ${CMAKE_COMMAND}
   "-DSTEP1=${TM_RENDER}|--scene|${TM_DIR}/tornado.json|--out|${TM_OUT}/st_frame.jpg"
-  "-DSTEP2=${TM_CHECK}|image|--scene|${TM_DIR}/tornado.json|--jpeg|${TM_OUT}/st_frame.jpg|--png|${TM_DIR}/golden/hotroom.png"
+  "-DSTEP2=${TM_CHECK}|image|--scene|${TM_DIR}/tornado.json|--jpeg|${TM_OUT}/st_frame.jpg|--png|${TM_DIR}/goldens/golden/hotroom.png"
   -DEXIT2=1 "-DERR2=the JPEG differs from [^\n]*hotroom\\.png by [0-9.]+ on average"
   ${TM_STEPS})
 

@@ -1,7 +1,10 @@
 /* regress.h — the parts of sightline-regress (tools/sightline_regress.c): a suite, its cases, their results.
  *
  * A suite is a folder: every *.json in it except suite.json and *.expect.json
- * is a case (a scene, or a scene with a path), with its golden image(s) in
+ * is a case (a scene, or a scene with a path), and so is every
+ * NAME.expect.json that names a scene elsewhere ("scene": a path relative to
+ * the suite, e.g. "../tornado.json", with optional "set": ["params.sides=6",
+ * ...], sightline-render's overrides), with its golden image(s) in
  * golden/: NAME.png (and NAME.pfm when the case checks depth), or for a
  * path golden/NAME/00000.png, 00001.png ... one a frame. suite.json (optional)
  * holds the defaults of the limits, NAME.expect.json (optional) a case's
@@ -9,8 +12,9 @@
  * over the covered pixels when background is set), background [R, G, B]
  * or null, samples (MSAA, 0..16), depth {max_mean, max_bad_pct,
  * bad_threshold, max_coverage_pct} (depth is checked only when given; not
- * for paths), timeout_s. Unknown keys are errors (a typo must not loosen a
- * limit). Single-threaded.
+ * for paths), timeout_s; an expect file also scene and set. Unknown keys are
+ * errors (a typo must not loosen a limit), and so is an expect file that
+ * names neither a NAME.json beside it nor a scene. Single-threaded.
  */
 #ifndef REGRESS_H
 #define REGRESS_H
@@ -22,6 +26,8 @@
 #define REGRESS_MAX_CASES 4096
 #define REGRESS_NAME_MAX 128
 #define REGRESS_PATH_MAX 4096
+#define REGRESS_MAX_SETS 8
+#define REGRESS_SET_MAX 256
 
 typedef struct regress_limits {
     double max_mean, max_bad_pct, bad_threshold, max_abs; /* max_abs < 0: no limit */
@@ -35,6 +41,8 @@ typedef struct regress_limits {
 typedef struct regress_case {
     char name[REGRESS_NAME_MAX];        /* file name without .json */
     char scene[REGRESS_PATH_MAX];       /* the scene file */
+    char sets[REGRESS_MAX_SETS][REGRESS_SET_MAX]; /* --set overrides (expect file "set") */
+    int set_count;
     int is_path;                        /* the scene has a "path" */
     int frames;                         /* 1, or the path's frame count */
     regress_limits limits;

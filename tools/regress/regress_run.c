@@ -51,6 +51,10 @@ static int build_argv(const regress_case *c, const char *render_exe, const char 
         snprintf(buf[2], sizeof buf[2], "%s/new/%s.pfm", out_dir, c->name);
         argv[n++] = buf[2];
     }
+    for (int k = 0; k < c->set_count; k++) {
+        argv[n++] = "--set";
+        argv[n++] = (char *)c->sets[k];
+    }
     argv[n] = NULL;
     return n;
 }
@@ -58,7 +62,7 @@ static int build_argv(const regress_case *c, const char *render_exe, const char 
 static pid_t start(const regress_case *c, const char *render_exe, const char *out_dir, regress_result *r)
 {
     char buf[6][REGRESS_PATH_MAX + 256], log[REGRESS_PATH_MAX + 256];
-    char *argv[16];
+    char *argv[16 + 2 * REGRESS_MAX_SETS];
     build_argv(c, render_exe, out_dir, buf, argv);
     snprintf(log, sizeof log, "%s/logs/%s.log", out_dir, c->name);
     int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);

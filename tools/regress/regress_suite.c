@@ -50,15 +50,18 @@ static sl_status only_keys(const cJSON *obj, const char *const *keys, const char
     return SL_OK;
 }
 
-/* Applies the limits of one JSON object (suite.json or NAME.expect.json) over *l. */
-static sl_status apply_limits(const cJSON *obj, regress_limits *l, const char *file, sl_err *err)
+/* Applies the limits of one JSON object (suite.json, or NAME.expect.json
+ * when expect: it may also hold scene and set) over *l. */
+static sl_status apply_limits(const cJSON *obj, int expect, regress_limits *l, const char *file, sl_err *err)
 {
     static const char *const keys[] = {"max_mean", "max_bad_pct", "bad_threshold", "max_abs", "background",
                                        "samples", "depth", "timeout_s", "description", NULL};
+    static const char *const expect_keys[] = {"max_mean", "max_bad_pct", "bad_threshold", "max_abs", "background",
+                                              "samples", "depth", "timeout_s", "description", "scene", "set", NULL};
     static const char *const depth_keys[] = {"max_mean", "max_bad_pct", "bad_threshold", "max_coverage_pct", NULL};
     if (!cJSON_IsObject(obj))
         return sl_err_set(err, SL_ERR_INVALID, "%s: must be a JSON object of limits", file);
-    sl_status st = only_keys(obj, keys, file, "", err);
+    sl_status st = only_keys(obj, expect ? expect_keys : keys, file, "", err);
     double samples = l->samples;
     if (st == SL_OK && (st = number(obj, "max_mean", 255, &l->max_mean, file, err)) == SL_OK &&
         (st = number(obj, "max_bad_pct", 100, &l->max_bad_pct, file, err)) == SL_OK &&
@@ -120,6 +123,37 @@ static sl_status read_json(const char *path, int optional, cJSON **out, sl_err *
     return *out ? SL_OK : sl_err_set(err, SL_ERR_INVALID, "%s: not valid JSON", path);
 }
 
+/* An expect file's scene (relative to the suite) and set overrides into c. */
+static sl_status case_source(const cJSON *expect, const char *dir, regress_case *c, const char *file, sl_err *err)
+{
+    const cJSON *scene = cJSON_GetObjectItemCaseSensitive(expect, "scene");
+    if (scene && c->scene[0])
+        return sl_err_set(err, SL_ERR_INVALID, "%s: names a scene, but %s.json is the case's scene already", file,
+                          c->name);
+    if (scene) {
+        if (!cJSON_IsString(scene) || !scene->valuestring[0] ||
+            strlen(dir) + strlen(scene->valuestring) + 2 > sizeof c->scene)
+            return sl_err_set(err, SL_ERR_INVALID, "%s: scene must be a scene file's path relative to the suite",
+                              file);
+        snprintf(c->scene, sizeof c->scene, "%s/%s", dir, scene->valuestring);
+    }
+    const cJSON *set = cJSON_GetObjectItemCaseSensitive(expect, "set");
+    if (!set)
+        return SL_OK;
+    int n = cJSON_IsArray(set) ? cJSON_GetArraySize(set) : -1;
+    if (n < 0 || n > REGRESS_MAX_SETS)
+        return sl_err_set(err, SL_ERR_INVALID, "%s: set must be an array of at most %d \"key.path=value\" strings",
+                          file, REGRESS_MAX_SETS);
+    c->set_count = 0;
+    for (const cJSON *e = set->child; e; e = e->next) {
+        if (!cJSON_IsString(e) || !strchr(e->valuestring, '=') || strlen(e->valuestring) >= REGRESS_SET_MAX)
+            return sl_err_set(err, SL_ERR_INVALID, "%s: set entries must be \"key.path=value\" strings of < %d bytes",
+                              file, REGRESS_SET_MAX);
+        snprintf(c->sets[c->set_count++], REGRESS_SET_MAX, "%s", e->valuestring);
+    }
+    return SL_OK;
+}
+
 static int by_name(const void *a, const void *b)
 {
     return strcmp(((const regress_case *)a)->name, ((const regress_case *)b)->name);
@@ -161,7 +195,7 @@ sl_status regress_suite_load(const char *dir, regress_suite *s, sl_err *err)
     cJSON *suite_json = NULL;
     sl_status st = read_json(path, 1, &suite_json, err);
     if (st == SL_OK && suite_json)
-        st = apply_limits(suite_json, &defaults, path, err);
+        st = apply_limits(suite_json, 0, &defaults, path, err);
     cJSON_Delete(suite_json);
     if (st != SL_OK)
         return st;
@@ -191,17 +225,29 @@ sl_status regress_suite_load(const char *dir, regress_suite *s, sl_err *err)
         snprintf(c->scene, sizeof c->scene, "%s/%s", dir, n);
         c->limits = defaults;
     }
-    /* Every NAME.expect.json belongs to a case: a typo in a name must not drop its limits silently. */
+    /* An expect file without its NAME.json is a case of its own when it names
+     * a scene (checked below); a typo in a name must not drop its limits. */
     rewinddir(d);
+    int scene_cases = s->count;
     for (struct dirent *e; st == SL_OK && (e = readdir(d)) != NULL;) {
         const char *n = e->d_name;
         if (n[0] == '.' || !ends_with(n, ".expect.json"))
             continue;
+        size_t len = strlen(n) - 12;
         int found = 0;
-        for (int i = 0; i < s->count && !found; i++)
-            found = strlen(s->cases[i].name) == strlen(n) - 12 && strncmp(s->cases[i].name, n, strlen(n) - 12) == 0;
-        if (!found)
-            st = sl_err_set(err, SL_ERR_INVALID, "suite %s: %s has no case %.*s.json", dir, n, (int)(strlen(n) - 12), n);
+        for (int i = 0; i < scene_cases && !found; i++)
+            found = strlen(s->cases[i].name) == len && strncmp(s->cases[i].name, n, len) == 0;
+        if (found)
+            continue;
+        if (len >= REGRESS_NAME_MAX || s->count == REGRESS_MAX_CASES) {
+            st = sl_err_set(err, SL_ERR_LIMIT, "suite %s: case %s: name too long or more than %d cases", dir, n,
+                            REGRESS_MAX_CASES);
+            break;
+        }
+        regress_case *c = &s->cases[s->count++];
+        snprintf(c->name, sizeof c->name, "%.*s", (int)len, n);
+        c->scene[0] = '\0'; /* must come from the expect file */
+        c->limits = defaults;
     }
     closedir(d);
     if (st == SL_OK && s->count == 0)
@@ -214,8 +260,13 @@ sl_status regress_suite_load(const char *dir, regress_suite *s, sl_err *err)
         cJSON *expect = NULL;
         st = read_json(path, 1, &expect, err);
         if (st == SL_OK && expect)
-            st = apply_limits(expect, &c->limits, path, err);
+            st = apply_limits(expect, 1, &c->limits, path, err);
+        if (st == SL_OK && expect)
+            st = case_source(expect, dir, c, path, err);
         cJSON_Delete(expect);
+        if (st == SL_OK && !c->scene[0])
+            st = sl_err_set(err, SL_ERR_INVALID, "suite %s: %s.expect.json has no case %s.json and names no scene",
+                            dir, c->name, c->name);
         if (st == SL_OK)
             st = inspect_scene(c, err);
     }
