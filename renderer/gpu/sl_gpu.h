@@ -122,6 +122,17 @@ sl_status sl_gl_check_errors(const char *what, sl_err *err);
 /* Tests only: the next sl_gl_check_errors reports `error` (as if GL had). */
 void sl_gl_inject_error(GLenum error);
 
+/* Compute dispatch along x in chunks (dispatch.c). sl_gpu_max_groups is the
+ * driver's GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] (65535 on llvmpipe, the GL
+ * minimum; a 1-D dispatch above it fails with GL_INVALID_VALUE and does
+ * nothing). sl_gpu_dispatch_chunked runs `groups` groups of the current
+ * program in dispatches of at most max_groups (0 or above the limit = the
+ * limit); before each it sets the uniform at group_base_location (the
+ * chunk's first group, which the shader adds to gl_WorkGroupID.x; -1 when
+ * the shader has none). Both need the current program's context. */
+unsigned sl_gpu_max_groups(void);
+void sl_gpu_dispatch_chunked(GLint group_base_location, size_t groups, unsigned max_groups);
+
 /* GPU timer (GL_TIME_ELAPSED query). */
 typedef struct sl_gpu_timer { GLuint query; int running; } sl_gpu_timer;
 void sl_gpu_timer_init(sl_gpu_timer *t);

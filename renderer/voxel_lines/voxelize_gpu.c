@@ -4,7 +4,7 @@
  * (voxel, code) items in curve order, voxel histogram, scatter item indices
  * into per-voxel segments, and per voxel: sort by item index, apply the cap,
  * bit-pack and sum lengths. The exclusive scans between passes (over curves;
- * over voxels, uncapped and capped) run on the GPU (voxel_scan.comp.glsl);
+ * over voxels, uncapped and capped) run on the GPU (gpu/sl_gpu_scan.h);
  * counts are read back only for statistics and the CPU copy of the headers.
  * With a colour attribute the per-vertex normalized values (the one division
  * of the attribute byte's definition, voxel_grid.h) are computed here with
@@ -22,6 +22,7 @@
 
 #include "../core/sl_clock.h"
 #include "../gpu/sl_gpu.h"
+#include "../gpu/sl_gpu_scan.h"
 
 #define PASSES 5
 
@@ -37,48 +38,12 @@ static GLuint ssbo(size_t bytes, const void *data)
     return b;
 }
 
-/* Dispatches `groups` work groups of `program` along x in chunks of at most
- * max_groups (the driver's GL_MAX_COMPUTE_WORK_GROUP_COUNT[0], 65535 on
- * llvmpipe, the GL minimum; a 1-D dispatch above it fails with
- * GL_INVALID_VALUE and does nothing). Each chunk gets its first group in the
- * uniform u_group_base, which the shaders add to gl_WorkGroupID.x. */
-static void dispatch(GLuint program, size_t groups, GLuint max_groups)
+/* Exclusive scan of n uints of `in` (each capped to cap) into a new buffer
+ * (*out; the caller deletes it, also on failure) with the shared GPU scan. */
+static sl_status scan_into_new(sl_gpu_scan *scan, GLuint in, size_t n, uint32_t cap, GLuint *out, sl_err *err)
 {
-    GLint base_loc = glGetUniformLocation(program, "u_group_base");
-    for (size_t first = 0; first < groups; first += max_groups) {
-        size_t n = groups - first < max_groups ? groups - first : max_groups;
-        glUniform1ui(base_loc, (GLuint)first);
-        glDispatchCompute((GLuint)n, 1, 1);
-    }
-}
-
-/* Exclusive scan of n uints of `in` (each capped to cap when cap > 0) into a
- * new buffer (returned; the caller deletes it). Blocks of 512 on the GPU,
- * the block totals scanned recursively. */
-static GLuint gpu_scan(const GLuint prog[2], GLuint in, size_t n, GLuint cap, GLuint max_groups)
-{
-    size_t blocks = (n + 511) / 512;
-    GLuint out = ssbo(n * sizeof(uint32_t), NULL), sums = ssbo(blocks * sizeof(uint32_t), NULL);
-    glUseProgram(prog[0]);
-    glUniform1ui(glGetUniformLocation(prog[0], "u_n"), (GLuint)n);
-    glUniform1ui(glGetUniformLocation(prog[0], "u_cap"), cap);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
-    dispatch(prog[0], blocks, max_groups);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    if (blocks > 1) {
-        GLuint scanned = gpu_scan(prog, sums, blocks, 0, max_groups);
-        glUseProgram(prog[1]);
-        glUniform1ui(glGetUniformLocation(prog[1], "u_n"), (GLuint)n);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, scanned);
-        dispatch(prog[1], blocks, max_groups);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glDeleteBuffers(1, &scanned);
-    }
-    glDeleteBuffers(1, &sums);
-    return out;
+    *out = ssbo(n * sizeof(uint32_t), NULL);
+    return sl_gpu_scan_u32_capped(scan, in, *out, (uint32_t)n, cap, err);
 }
 
 /* One invocation per element 0..count-1, 64 per group. */
@@ -86,7 +51,7 @@ static void run(GLuint program, GLuint count, GLuint max_groups)
 {
     glUseProgram(program);
     glUniform1ui(glGetUniformLocation(program, "u_count"), count);
-    dispatch(program, ((size_t)count + 63) / 64, max_groups);
+    sl_gpu_dispatch_chunked(glGetUniformLocation(program, "u_group_base"), ((size_t)count + 63) / 64, max_groups);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
@@ -104,12 +69,9 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
      * at the end reports only this build's. */
     while (glGetError() != GL_NO_ERROR) {
     }
-    GLint limit = 0;
-    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &limit);
-    if (limit <= 0)
-        limit = 65535; /* the GL 4.3 minimum */
-    if (max_groups == 0 || max_groups > (unsigned)limit)
-        max_groups = (unsigned)limit;
+    unsigned limit = sl_gpu_max_groups();
+    if (max_groups == 0 || max_groups > limit)
+        max_groups = limit;
     double t0 = sl_clock_ms();
     sl_voxel_grid_desc d = desc ? *desc : (sl_voxel_grid_desc){0};
     if (d.quant == 0) d.quant = 32;
@@ -131,7 +93,8 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
     g->voxel_count = (size_t)g->frame.dims[0] * g->frame.dims[1] * g->frame.dims[2];
     g->attribute_index = d.attribute >= 0 && d.attribute < l->attribute_count ? d.attribute : -1;
 
-    GLuint prog[PASSES] = {0}, scan_prog[2] = {0};
+    GLuint prog[PASSES] = {0};
+    sl_gpu_scan scan = {0};
     GLuint buf[11] = {0};
     uint32_t *curve_counts = NULL, *voxel_counts = NULL, *line_starts = NULL;
     for (int p = 0; p < PASSES && st == SL_OK; p++) {
@@ -142,12 +105,9 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
                                                      .defines = defines, .label = label},
                                   &prog[p], err);
     }
-    for (int p = 0; p < 2 && st == SL_OK; p++)
-        st = sl_gl_program_create(&(sl_program_desc){.compute = "voxel_lines/voxel_scan.comp.glsl",
-                                                     .defines = p == 0 ? "#define SCAN_PASS 1\n"
-                                                                       : "#define SCAN_PASS 2\n",
-                                                     .label = "voxel_scan"},
-                                  &scan_prog[p], err);
+    if (st == SL_OK)
+        st = sl_gpu_scan_init(&scan, err);
+    scan.max_groups = max_groups;
     if (st != SL_OK)
         goto fail;
     size_t curves = l->line_count;
@@ -203,9 +163,12 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
         st = sl_err_set(err, SL_ERR_LIMIT, "GPU voxelization: more than %u pieces", SL_MAX_VERTICES * 8u);
         goto fail;
     }
-    GLuint curve_starts = gpu_scan(scan_prog, buf[2], curves + 1, 0, max_groups);
+    GLuint curve_starts = 0;
+    st = scan_into_new(&scan, buf[2], curves + 1, UINT32_MAX, &curve_starts, err);
     glDeleteBuffers(1, &buf[2]);
     buf[2] = curve_starts;
+    if (st != SL_OK)
+        goto fail;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buf[0]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buf[1]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, buf[2]);
@@ -243,8 +206,11 @@ sl_status sl_voxel_grid_build_gpu_chunked(sl_voxel_grid *g, const sl_dataset *ds
      * capped (line offsets), on the GPU. The counts are read back for the
      * CPU copy of the headers and the statistics. */
     glGetNamedBufferSubData(buf[4], 0, (GLsizeiptr)(g->voxel_count * sizeof(uint32_t)), voxel_counts);
-    buf[5] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, 0, max_groups);
-    buf[7] = gpu_scan(scan_prog, buf[4], g->voxel_count + 1, (GLuint)d.max_per_voxel, max_groups);
+    st = scan_into_new(&scan, buf[4], g->voxel_count + 1, UINT32_MAX, &buf[5], err);
+    if (st == SL_OK)
+        st = scan_into_new(&scan, buf[4], g->voxel_count + 1, (uint32_t)d.max_per_voxel, &buf[7], err);
+    if (st != SL_OK)
+        goto fail;
     glGetNamedBufferSubData(buf[7], 0, (GLsizeiptr)((g->voxel_count + 1) * sizeof(uint32_t)), line_starts);
     size_t s_kept = line_starts[g->voxel_count];
     for (size_t v = 0; v < g->voxel_count; v++) {
@@ -302,9 +268,7 @@ done:
     for (int p = 0; p < PASSES; p++)
         if (prog[p])
             glDeleteProgram(prog[p]);
-    for (int p = 0; p < 2; p++)
-        if (scan_prog[p])
-            glDeleteProgram(scan_prog[p]);
+    sl_gpu_scan_deinit(&scan);
     for (int b = 0; b < 11; b++)
         if (buf[b])
             glDeleteBuffers(1, &buf[b]);
