@@ -598,7 +598,8 @@ static const sl_param_def test_schema[] = {
     {"ra", SL_PARAM_ATTRIBUTE, 0, 3, {1}, NULL, "", "an attribute without none", SL_INVALIDATE_PREPARED},
 };
 enum { TEST_COUNT = (int)(sizeof test_schema / sizeof test_schema[0]) };
-static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL, NULL};
+static const sl_technique test_tech = {.name = "private", .description = "a private schema", .dataset_kinds = 1,
+                                        .params = test_schema, .param_count = TEST_COUNT};
 
 static void test_private_schema(void)
 {
