@@ -84,11 +84,13 @@ static double moved_number(const sl_param_def *d, double v)
 }
 
 /* Moves parameter i of p to a different valid value; returns 0 if the
- * setter refused it (a test failure: the value was chosen inside the schema). */
-static int move_param(sl_params *p, int i, sl_err *err)
+ * setter refused it (a test failure: the value was chosen inside the schema).
+ * ds gives an empty VALUES list its first value: the middle of a volume's
+ * value range (the schema's middle, 0 of +-1e30, may lie outside the data). */
+static int move_param(sl_params *p, int i, const sl_dataset *ds, sl_err *err)
 {
     const sl_param_def *d = &p->schema[i];
-    double v[3] = {p->value[i][0], p->value[i][1], p->value[i][2]};
+    double v[SL_PARAM_VALUES_MAX] = {p->value[i][0], p->value[i][1], p->value[i][2], p->value[i][3]};
     int n = 1;
     switch (d->type) {
     case SL_PARAM_BOOL:
@@ -126,6 +128,23 @@ static int move_param(sl_params *p, int i, sl_err *err)
         int last = tf.count - 1, alpha = tf.colormap >= 0 ? 1 : 4;
         tf.point[last][alpha] = tf.point[last][alpha] > 0.5 ? 0.25 : 0.75;
         return sl_params_set_transfer(p, d->name, &tf, err) == SL_OK;
+    }
+    case SL_PARAM_VALUES:
+        /* An empty list (auto) becomes one value; else the first value moves like a number. */
+        n = p->value_count[i];
+        if (n == 0) {
+            v[0] = ds->kind == SL_DATASET_LINES ? 0.5 * (d->min + d->max)
+                                                : 0.5 * (ds->volume.value_min + ds->volume.value_max);
+            n = 1;
+        } else {
+            v[0] = moved_number(d, v[0]);
+        }
+        break;
+    case SL_PARAM_TRANSFER_2D: {
+        sl_transfer_function_2d tf = *sl_params_transfer_2d(p, d->name);
+        double *alpha = &tf.widget[tf.count - 1][6];
+        *alpha = *alpha > 0.5 ? 0.25 : 0.75;
+        return sl_params_set_transfer_2d(p, d->name, &tf, err) == SL_OK;
     }
     }
     return sl_params_set_numbers(p, d->name, v, n, err) == SL_OK;
@@ -190,7 +209,7 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
             single_choice++; /* an enum of one choice (ribbons' pipeline today) has nothing to move to */
             continue;
         }
-        if (!move_param(&params, i, &err)) {
+        if (!move_param(&params, i, pds, &err)) {
             SL_CHECK_MSG(0, "%s: cannot move parameter '%s': %s", t->name, d->name, err.message);
             continue;
         }
@@ -335,9 +354,14 @@ static void test_orbit_frames(sl_gpu *gpu)
 
 /* ---- sl_pipeline_export ------------------------------------------------------ */
 
-/* A private technique that draws nothing and exports what it was given. */
+/* A private technique that draws nothing and exports what it was given; its
+ * schema also holds the list and 2D types no registered technique uses yet,
+ * so test_technique's moves cover them. */
 static const sl_param_def exporter_params[] = {
     {"level", SL_PARAM_FLOAT, 0, 10, {1}, NULL, "", "a frame-level number the export reads", SL_INVALIDATE_FRAME},
+    {"isovalues", SL_PARAM_VALUES, -1e30, 1e30, {0}, NULL, "data", "a list, [] = auto", SL_INVALIDATE_PREPARED},
+    {"curvature_tf", SL_PARAM_TRANSFER_2D, 0, 0, {SL_TF2D_PRESET_RIDGES_VALLEYS}, NULL, "1/voxel", "a 2D function",
+     SL_INVALIDATE_FRAME},
 };
 typedef struct exporter_state {
     int exports;
@@ -387,7 +411,7 @@ static void exporter_stats(const void *state, sl_prepare_stats *out)
 
 static const sl_technique exporter = {
     .name = "exporter", .description = "test-only: exports what it is given", .dataset_kinds = SL_DATASET_VOLUME,
-    .params = exporter_params, .param_count = 1, .prepare = exporter_prepare, .render = exporter_render,
+    .params = exporter_params, .param_count = 3, .prepare = exporter_prepare, .render = exporter_render,
     .release = exporter_release, .prepare_stats = exporter_stats, .export_ext = ".txt",
     .export_geometry = exporter_export,
 };
@@ -418,7 +442,7 @@ static void test_export(sl_gpu *gpu)
                  strstr(err.message, "export is offered by: "), "%d: %s", (int)st, err.message);
 
     /* The private exporter: nothing prepared yet, then the state, the params and the path. */
-    sl_params_init(&params, exporter_params, 1);
+    sl_params_init(&params, exporter_params, 3);
     SL_CHECK(sl_pipeline_set_technique(pipe, &exporter, &params, &err) == SL_OK);
     SL_CHECK(sl_pipeline_export(pipe, "x.txt", &err) == SL_ERR_INVALID && strstr(err.message, "render a frame first"));
     sl_frame_stats stats;
@@ -454,6 +478,7 @@ int main(void)
     }
     test_orbit_frames(gpu);
     test_export(gpu);
+    test_technique(gpu, &exporter); /* the re-prepare rule for values and transfer_2d */
     sl_gpu_destroy(gpu);
     SL_TEST_END();
 }
