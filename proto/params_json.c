@@ -123,6 +123,71 @@ static sl_status apply_transfer(sl_params *p, const char *name, const cJSON *ite
     return sl_params_set_transfer(p, name, &tf, err);
 }
 
+/* A VALUES list from JSON: an array of 0 .. SL_PARAM_VALUES_MAX numbers ([] = auto);
+ * range errors come from sl_params_set_numbers, naming the index. */
+static sl_status apply_values(sl_params *p, const sl_param_def *d, const cJSON *item, sl_err *err)
+{
+    const char *space = d->unit[0] ? " " : "";
+    if (!cJSON_IsArray(item))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an array of 0 to %d numbers in [%g, %g]%s%s "
+                          "([] = auto)", d->name, SL_PARAM_VALUES_MAX, d->min, d->max, space, d->unit);
+    int n = cJSON_GetArraySize(item);
+    if (n > SL_PARAM_VALUES_MAX)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes at most %d values in [%g, %g]%s%s, got %d",
+                          d->name, SL_PARAM_VALUES_MAX, d->min, d->max, space, d->unit, n);
+    double v[SL_PARAM_VALUES_MAX];
+    int k = 0;
+    for (const cJSON *e = item->child; e; e = e->next, k++) {
+        if (!cJSON_IsNumber(e))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': value %d must be a number in [%g, %g]%s%s", d->name,
+                              k, d->min, d->max, space, d->unit);
+        v[k] = e->valuedouble;
+    }
+    return sl_params_set_numbers(p, d->name, v, n, err);
+}
+
+/* A 2D transfer function from JSON: {"range": r, "widgets": [[k1, k2, radius,
+ * r, g, b, a], ...]}, both keys required. Shape errors name the widget;
+ * value errors come from sl_params_set_transfer_2d. */
+static sl_status apply_transfer_2d(sl_params *p, const char *name, const cJSON *item, sl_err *err)
+{
+    static const char usage[] = "{\"range\": r, \"widgets\": [[k1, k2, radius, r, g, b, a], ...]}";
+    if (!cJSON_IsObject(item))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes %s", name, usage);
+    for (const cJSON *k = item->child; k; k = k->next)
+        if (strcmp(k->string, "range") != 0 && strcmp(k->string, "widgets") != 0)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': unknown key '%.40s' (takes %s)", name, k->string,
+                              usage);
+    const cJSON *range = cJSON_GetObjectItemCaseSensitive(item, "range");
+    const cJSON *widgets = cJSON_GetObjectItemCaseSensitive(item, "widgets");
+    if (!cJSON_IsNumber(range))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': \"range\" must be a number > 0 (takes %s)", name, usage);
+    if (!cJSON_IsArray(widgets))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': \"widgets\" must be an array (takes %s)", name, usage);
+    int n = cJSON_GetArraySize(widgets);
+    if (n < 1 || n > SL_TF2D_MAX_WIDGETS)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' takes 1 to %d widgets, got %d", name,
+                          SL_TF2D_MAX_WIDGETS, n);
+    sl_transfer_function_2d tf;
+    memset(&tf, 0, sizeof tf);
+    tf.count = n;
+    tf.range = range->valuedouble;
+    int k = 0;
+    for (const cJSON *w = widgets->child; w; w = w->next, k++) {
+        if (!cJSON_IsArray(w) || cJSON_GetArraySize(w) != 7)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': widget %d must be [k1, k2, radius, r, g, b, a]",
+                              name, k);
+        int c = 0;
+        for (const cJSON *e = w->child; e; e = e->next, c++) {
+            if (!cJSON_IsNumber(e))
+                return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': widget %d must be [k1, k2, radius, r, g, b, a] "
+                                  "of numbers", name, k);
+            tf.widget[k][c] = e->valuedouble;
+        }
+    }
+    return sl_params_set_transfer_2d(p, name, &tf, err);
+}
+
 static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
 {
     const char *name = item->string;
@@ -165,6 +230,10 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
         return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
     case SL_PARAM_TRANSFER:
         return apply_transfer(p, name, item, err);
+    case SL_PARAM_VALUES:
+        return apply_values(p, d, item, err);
+    case SL_PARAM_TRANSFER_2D:
+        return apply_transfer_2d(p, name, item, err);
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
         if (!cJSON_IsNumber(item))
@@ -212,7 +281,27 @@ static cJSON *transfer_json(const sl_transfer_function *tf)
     return o;
 }
 
-static cJSON *value_json(const sl_param_def *d, const double v[3])
+static cJSON *transfer_2d_json(const sl_transfer_function_2d *tf)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "range", tf->range);
+    cJSON *a = cJSON_AddArrayToObject(o, "widgets");
+    for (int k = 0; a && k < tf->count; k++)
+        cJSON_AddItemToArray(a, cJSON_CreateDoubleArray(tf->widget[k], 7));
+    return o;
+}
+
+/* [v0, ...] of a VALUES list ([] when empty). */
+static cJSON *values_json(const double *v, int count)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int k = 0; a && k < count; k++)
+        cJSON_AddItemToArray(a, cJSON_CreateNumber(v[k]));
+    return a;
+}
+
+/* The value of entry d, of which v holds the numbers (a schema default: d->def). */
+static cJSON *value_json(const sl_param_def *d, const double *v)
 {
     switch (d->type) {
     case SL_PARAM_TRANSFER: {
@@ -220,6 +309,12 @@ static cJSON *value_json(const sl_param_def *d, const double v[3])
         sl_transfer_function_default(d, &tf);
         return transfer_json(&tf);
     }
+    case SL_PARAM_TRANSFER_2D: {
+        sl_transfer_function_2d tf;
+        sl_transfer_function_2d_preset((int)d->def[0], &tf);
+        return transfer_2d_json(&tf);
+    }
+    case SL_PARAM_VALUES: return values_json(v, 0); /* the default: the empty list */
     case SL_PARAM_BOOL: return cJSON_CreateBool(v[0] != 0.0);
     case SL_PARAM_ENUM: return cJSON_CreateString(d->choices[(int)v[0]]);
     case SL_PARAM_VEC3: return cJSON_CreateDoubleArray(v, 3);
@@ -233,10 +328,14 @@ static cJSON *value_json(const sl_param_def *d, const double v[3])
 cJSON *sl_params_to_json(const sl_params *p)
 {
     cJSON *o = cJSON_CreateObject();
-    for (int i = 0; o && i < p->count; i++)
-        cJSON_AddItemToObject(o, p->schema[i].name, p->schema[i].type == SL_PARAM_TRANSFER
-                                  ? transfer_json(&p->tf[(int)p->value[i][0]])
-                                  : value_json(&p->schema[i], p->value[i]));
+    for (int i = 0; o && i < p->count; i++) {
+        const sl_param_def *d = &p->schema[i];
+        cJSON *v = d->type == SL_PARAM_TRANSFER      ? transfer_json(&p->tf[(int)p->value[i][0]])
+                   : d->type == SL_PARAM_TRANSFER_2D ? transfer_2d_json(&p->tf2d)
+                   : d->type == SL_PARAM_VALUES      ? values_json(p->value[i], p->value_count[i])
+                                                     : value_json(d, p->value[i]);
+        cJSON_AddItemToObject(o, d->name, v);
+    }
     return o;
 }
 
@@ -260,10 +359,14 @@ cJSON *sl_params_schema_json(const sl_param_def *schema, int count)
         cJSON_AddStringToObject(o, "name", d->name);
         cJSON_AddStringToObject(o, "type", sl_param_type_name(d->type));
         if (d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3 ||
-            d->type == SL_PARAM_ATTRIBUTE) {
+            d->type == SL_PARAM_ATTRIBUTE || d->type == SL_PARAM_VALUES) {
             cJSON_AddNumberToObject(o, "min", d->min);
             cJSON_AddNumberToObject(o, "max", d->max);
         }
+        if (d->type == SL_PARAM_VALUES)
+            cJSON_AddNumberToObject(o, "max_count", SL_PARAM_VALUES_MAX);
+        if (d->type == SL_PARAM_TRANSFER_2D)
+            cJSON_AddNumberToObject(o, "max_widgets", SL_TF2D_MAX_WIDGETS);
         cJSON_AddItemToObject(o, "default", value_json(d, d->def));
         if (d->type == SL_PARAM_ENUM) {
             cJSON *c = cJSON_AddArrayToObject(o, "choices");

@@ -181,7 +181,11 @@ static uint64_t scene_key(const sl_session_state *st)
     h = fnv1a(h, st->dataset_source, strlen(st->dataset_source) + 1);
     h = fnv1a(h, st->technique, strlen(st->technique) + 1);
     h = fnv1a(h, st->params.value, sizeof st->params.value[0] * (size_t)st->params.count);
+    h = fnv1a(h, st->params.value_count, sizeof st->params.value_count[0] * (size_t)st->params.count);
     h = fnv1a(h, st->params.tf, sizeof st->params.tf); /* transfer functions: unused entries are zero */
+    h = fnv1a(h, &st->params.tf2d.count, sizeof st->params.tf2d.count); /* field by field: no padding */
+    h = fnv1a(h, &st->params.tf2d.range, sizeof st->params.tf2d.range);
+    h = fnv1a(h, st->params.tf2d.widget, sizeof st->params.tf2d.widget); /* unused widgets are zero */
     h = fnv1a(h, &st->width, sizeof st->width);
     return fnv1a(h, &st->height, sizeof st->height);
 }

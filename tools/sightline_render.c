@@ -2,7 +2,7 @@
  *
  * usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm]
  *          [--frames N] [--stats stats.json] [--set key.path=value ...]
- *          [--samples N] [--data-dir DIR]
+ *          [--samples N] [--data-dir DIR] [--export FILE]
  *        sightline-render --path P.json [--out frames/%05d.png] [--video V.mp4|.webm]
  *          [--crf N] [--stats ...] [--set ...]
  * A scene with a `path` (proto/scene.md "Paths") renders every frame of it,
@@ -10,6 +10,8 @@
  * a video (image/sl_video.h: .mp4 H.264, .webm VP9, constant quality --crf);
  * --path is --scene that also requires the path. --video without a path
  * records the --frames N frames (e.g. an orbit_frames turntable) at 24 fps.
+ * --export writes the technique's derived geometry after the last frame
+ * (sl_pipeline_export), in the one format the technique names (export_ext).
  * A thin main over the renderer library: scene -> dataset -> pipeline. The
  * colour frame uses --samples MSAA (default 4); the depth map is rendered
  * without MSAA so every pixel is the exact centre ray of sl_camera.h.
@@ -52,7 +54,7 @@
 #define EXIT_GPU 3
 
 typedef struct options {
-    const char *scene, *out, *depth, *stats, *data_dir, *video;
+    const char *scene, *out, *depth, *stats, *data_dir, *video, *export_path;
     int require_path;           /* --path given */
     int crf;                    /* -1: the codec's default */
     const char *sets[MAX_SETS];
@@ -62,7 +64,7 @@ typedef struct options {
 static void print_usage(FILE *f)
 {
     fprintf(f, "usage: sightline-render --scene S.json --out frame.png [--depth depth.pfm] [--frames N]\n"
-               "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR]\n"
+               "         [--stats stats.json] [--set key.path=value ...] [--samples N] [--data-dir DIR] [--export FILE]\n"
                "       sightline-render --path P.json [--out frames/%%05d.png] [--video V.mp4] [--crf N] [--stats ...]\n"
                "  --path     a scene with a \"path\": every frame of it to the --out pattern (one %%d or %%0Nd)\n"
                "  --video    .mp4 (H.264, CRF 18 by default) or .webm (VP9, CRF 24): every frame, at the path's\n"
@@ -71,6 +73,7 @@ static void print_usage(FILE *f)
                "  --stats    .json                            --frames N in [1, 100000] (default 1)\n"
                "  --samples  MSAA samples in [0, 16] (default 4; 0 or 1 = none; at most what the GPU offers)\n"
                "  --data-dir where relative dataset paths are looked up (default: the scene's folder)\n"
+               "  --export   the technique's derived geometry after the last frame, in the format it names (e.g. .csv)\n"
                "exit: 0 ok, 1 usage, 2 bad input (scene, dataset, parameters, output paths, write failed),\n"
                "      3 GPU (no EGL display or 4.5 context, bad SIGHTLINE_EGL_DEVICE, above a GPU limit such\n"
                "      as --samples, GL failure)\n");
@@ -117,7 +120,7 @@ static int parse_args(int argc, char **argv, options *o)
         if (strncmp(a, "--", 2) != 0)
             return usage("unexpected argument '%s' (every value follows its option, e.g. --scene S.json)", a);
         static const char *const known[] = {"--scene", "--path", "--out", "--depth", "--stats", "--data-dir",
-                                            "--frames", "--samples", "--set", "--video", "--crf", NULL};
+                                            "--frames", "--samples", "--set", "--video", "--crf", "--export", NULL};
         int k = 0;
         while (known[k] && strcmp(a, known[k]) != 0)
             k++;
@@ -141,6 +144,7 @@ static int parse_args(int argc, char **argv, options *o)
         else if (strcmp(a, "--depth") == 0) o->depth = v;
         else if (strcmp(a, "--stats") == 0) o->stats = v;
         else if (strcmp(a, "--data-dir") == 0) o->data_dir = v;
+        else if (strcmp(a, "--export") == 0) o->export_path = v;
         else if (strcmp(a, "--frames") == 0) {
             if (!parse_int(v, 1, 100000, &o->frames))
                 return usage("--frames must be an integer in [1, 100000], got '%s'", v);
@@ -235,6 +239,35 @@ static int check_outputs(const options *o)
            (!o->video || check_output("--video", o->video, video_exts)) &&
            (!o->depth || check_output("--depth", o->depth, depth_exts)) &&
            (!o->stats || check_output("--stats", o->stats, stats_exts));
+}
+
+/* --export, once the technique is known: it must export, in its own
+ * extension (usage errors: 1), to a writable path (bad input: 2). Prints the
+ * reason; returns 0 when all hold, else the exit code. */
+static int check_export(const options *o, const sl_technique *tech)
+{
+    if (!o->export_path)
+        return 0;
+    if (!sl_technique_exports(tech)) {
+        char list[256];
+        sl_technique_exporters(list, sizeof list);
+        fprintf(stderr, "sightline-render: technique '%s' exports nothing (--export is offered by: %s)\n", tech->name,
+                list);
+        return EXIT_USAGE;
+    }
+    if (!ends_with(o->export_path, tech->export_ext)) {
+        fprintf(stderr, "sightline-render: --export %s: technique '%s' exports %s files (the path must end in %s)\n",
+                o->export_path, tech->name, tech->export_ext, tech->export_ext);
+        return EXIT_USAGE;
+    }
+    const char *const others[] = {o->out, o->depth, o->stats, o->video};
+    for (int k = 0; k < 4; k++)
+        if (others[k] && strcmp(others[k], o->export_path) == 0) {
+            fprintf(stderr, "sightline-render: --export %s: also named by another output\n", o->export_path);
+            return EXIT_USAGE;
+        }
+    const char *const exts[] = {tech->export_ext, NULL};
+    return check_output("--export", o->export_path, exts) ? 0 : EXIT_BAD_INPUT;
 }
 
 /* Exit code of a pipeline (GPU-side) failure: the GPU's (3: GL failure, or
@@ -334,6 +367,15 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
             cJSON_AddNumberToObject(s, split[i], split_ms[i]);
         else
             cJSON_AddNullToObject(s, split[i]);
+    }
+    /* The technique's own named numbers of that prepare ({} when none). */
+    cJSON *extra = cJSON_AddObjectToObject(s, "prepare_extra");
+    int extra_count = first->prepare.extra_count;
+    for (int i = 0; extra && i < extra_count && i < SL_STATS_EXTRA_MAX; i++) {
+        const sl_stat_value *e = &first->prepare.extra[i];
+        char name[sizeof e->name + 1];
+        snprintf(name, sizeof name, "%.*s", (int)sizeof e->name, e->name); /* terminated even if a technique forgot */
+        cJSON_AddNumberToObject(extra, name, e->value);
     }
     cJSON_AddNumberToObject(s, "gpu_bytes", (double)last->gpu_bytes);
     cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
@@ -443,6 +485,10 @@ int main(int argc, char **argv)
     if (!check_path_options(&o, &scene, tech)) {
         sl_scene_deinit(&scene);
         return EXIT_USAGE;
+    }
+    if ((rc = check_export(&o, tech)) != 0) {
+        sl_scene_deinit(&scene);
+        return rc;
     }
     sl_err verr = {0};
     if (o.video && sl_video_check(&(sl_video_desc){o.video, scene.width, scene.height,
@@ -574,6 +620,14 @@ int main(int argc, char **argv)
             exit_code = EXIT_BAD_INPUT;
             goto done;
         }
+    }
+    if (o.export_path) {
+        if ((st = sl_pipeline_export(pipe, o.export_path, &err)) != SL_OK) {
+            fprintf(stderr, "sightline-render: --export: %s\n", err.message);
+            exit_code = exit_for(st);
+            goto done;
+        }
+        printf("exported %s (%s)\n", o.export_path, tech->name);
     }
     if (o.stats && !write_stats(&o, &scene, gpu, tech, gpu_ms, wall_ms, load_ms, &first, &last)) {
         exit_code = EXIT_BAD_INPUT;

@@ -13,17 +13,32 @@ void sl_params_init(sl_params *p, const sl_param_def *schema, int count)
     memset(p, 0, sizeof *p);
     p->schema = schema;
     p->count = count;
-    int slots = 0;
+    int slots = 0, tf2d_entries = 0;
     for (int i = 0; i < count; i++) {
-        if (schema[i].type == SL_PARAM_TRANSFER) {
+        switch (schema[i].type) {
+        case SL_PARAM_TRANSFER:
             assert(slots < SL_PARAMS_MAX_TF);
             if (slots >= SL_PARAMS_MAX_TF)
                 continue;
             p->value[i][0] = slots;
             sl_transfer_function_default(&schema[i], &p->tf[slots++]);
-            continue;
+            break;
+        case SL_PARAM_TRANSFER_2D:
+            assert(tf2d_entries == 0 && "one TRANSFER_2D entry per schema");
+            if (tf2d_entries++ == 0)
+                sl_transfer_function_2d_preset((int)schema[i].def[0], &p->tf2d);
+            break;
+        case SL_PARAM_VALUES: /* the empty list (auto) */
+            break;
+        case SL_PARAM_FLOAT:
+        case SL_PARAM_INT:
+        case SL_PARAM_BOOL:
+        case SL_PARAM_ENUM:
+        case SL_PARAM_VEC3:
+        case SL_PARAM_ATTRIBUTE:
+            memcpy(p->value[i], schema[i].def, sizeof schema[i].def);
+            break;
         }
-        memcpy(p->value[i], schema[i].def, sizeof p->value[i]);
     }
 }
 
@@ -118,6 +133,29 @@ sl_status sl_params_set_transfer(sl_params *p, const char *name, const sl_transf
     return SL_OK;
 }
 
+sl_status sl_params_set_transfer_2d(sl_params *p, const char *name, const sl_transfer_function_2d *tf, sl_err *err)
+{
+    int i = sl_params_find(p, name);
+    if (i < 0)
+        return sl_err_set(err, SL_ERR_INVALID, "unknown parameter '%s'", name);
+    if (p->schema[i].type != SL_PARAM_TRANSFER_2D)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes no 2D transfer function", name,
+                          sl_param_type_name(p->schema[i].type));
+    sl_status st = sl_transfer_function_2d_check(name, tf, err);
+    if (st != SL_OK)
+        return st;
+    /* Stored with unused widgets zeroed, so equal functions compare equal. */
+    sl_transfer_function_2d clean;
+    memset(&clean, 0, sizeof clean);
+    clean.count = tf->count;
+    clean.range = tf->range;
+    for (int k = 0; k < tf->count; k++)
+        for (int c = 0; c < 7; c++)
+            clean.widget[k][c] = tf->widget[k][c] == 0.0 ? 0.0 : tf->widget[k][c]; /* -0 -> 0 */
+    p->tf2d = clean;
+    return SL_OK;
+}
+
 int sl_params_find(const sl_params *p, const char *name)
 {
     for (int i = 0; i < p->count; i++)
@@ -150,6 +188,29 @@ static sl_status unknown_parameter(const sl_params *p, const char *name, sl_err 
     return sl_err_set(err, SL_ERR_INVALID, "unknown parameter '%s' (known: %s)", name, known);
 }
 
+/* A VALUES list: 0 .. SL_PARAM_VALUES_MAX finite numbers, each in [min, max]; errors name the index. */
+static sl_status set_values(sl_params *p, int i, const double *v, int n, sl_err *err)
+{
+    const sl_param_def *d = &p->schema[i];
+    const char *space = d->unit[0] ? " " : "";
+    if (n < 0 || n > SL_PARAM_VALUES_MAX)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (values) takes 0 to %d numbers in [%g, %g]%s%s, got %d",
+                          d->name, SL_PARAM_VALUES_MAX, d->min, d->max, space, d->unit, n);
+    for (int k = 0; k < n; k++) {
+        if (!isfinite(v[k]))
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': value %d must be a finite number in [%g, %g]%s%s, "
+                              "got %g", d->name, k, d->min, d->max, space, d->unit, v[k]);
+        if (v[k] < d->min || v[k] > d->max)
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s': value %d = %g is out of range [%g, %g]%s%s", d->name,
+                              k, v[k], d->min, d->max, space, d->unit);
+    }
+    /* Unused entries zero, so equal lists compare equal bytewise. */
+    for (int k = 0; k < SL_PARAM_VALUES_MAX; k++)
+        p->value[i][k] = k < n ? v[k] : 0.0;
+    p->value_count[i] = n;
+    return SL_OK;
+}
+
 sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v, int n, sl_err *err)
 {
     int i = sl_params_find(p, name);
@@ -159,6 +220,11 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
     if (d->type == SL_PARAM_TRANSFER)
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (transfer_function) takes control points "
                           "[[value, r, g, b, a], ...] or {\"colormap\": name, \"opacity\": [[t, a], ...]}, not numbers", name);
+    if (d->type == SL_PARAM_TRANSFER_2D)
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (transfer_2d) takes {\"range\": r, \"widgets\": "
+                          "[[k1, k2, radius, r, g, b, a], ...]}, not numbers", name);
+    if (d->type == SL_PARAM_VALUES)
+        return set_values(p, i, v, n, err);
     int want = d->type == SL_PARAM_VEC3 ? 3 : 1;
     if (n != want)
         return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' (%s) takes %d number%s, got %d",
@@ -189,7 +255,9 @@ sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v,
                 return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be an integer in [%g, %g], got %g",
                                   name, d->min, d->max, v[k]);
             /* fall through */
-        case SL_PARAM_TRANSFER: /* refused above */
+        case SL_PARAM_TRANSFER: /* refused or handled above */
+        case SL_PARAM_TRANSFER_2D:
+        case SL_PARAM_VALUES:
         case SL_PARAM_FLOAT:
         case SL_PARAM_VEC3:
             if (v[k] < d->min || v[k] > d->max)
@@ -302,6 +370,21 @@ const sl_transfer_function *sl_params_transfer(const sl_params *p, const char *n
     return i < 0 ? &p->tf[0] : &p->tf[(int)p->value[i][0]];
 }
 
+int sl_params_values(const sl_params *p, const char *name, double out[SL_PARAM_VALUES_MAX])
+{
+    int i = checked_index(p, name, SL_PARAM_VALUES);
+    int n = i < 0 ? 0 : p->value_count[i];
+    for (int k = 0; k < SL_PARAM_VALUES_MAX; k++)
+        out[k] = k < n ? p->value[i][k] : 0.0;
+    return n;
+}
+
+const sl_transfer_function_2d *sl_params_transfer_2d(const sl_params *p, const char *name)
+{
+    (void)checked_index(p, name, SL_PARAM_TRANSFER_2D);
+    return &p->tf2d;
+}
+
 /* Field by field (no padding compared). */
 int sl_transfer_function_equal(const sl_transfer_function *a, const sl_transfer_function *b)
 {
@@ -316,9 +399,12 @@ sl_invalidation sl_params_compare(const sl_params *a, const sl_params *b)
         return SL_INVALIDATE_PREPARED;
     sl_invalidation level = SL_INVALIDATE_NONE;
     for (int i = 0; i < a->count; i++) {
-        int differs = memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0;
+        int differs = memcmp(a->value[i], b->value[i], sizeof a->value[i]) != 0 ||
+                      a->value_count[i] != b->value_count[i];
         if (!differs && a->schema[i].type == SL_PARAM_TRANSFER)
             differs = !sl_transfer_function_equal(&a->tf[(int)a->value[i][0]], &b->tf[(int)b->value[i][0]]);
+        if (!differs && a->schema[i].type == SL_PARAM_TRANSFER_2D)
+            differs = !sl_transfer_function_2d_equal(&a->tf2d, &b->tf2d);
         if (differs && a->schema[i].invalidates > level)
             level = a->schema[i].invalidates;
     }
@@ -335,6 +421,8 @@ const char *sl_param_type_name(sl_param_type t)
     case SL_PARAM_VEC3: return "vec3";
     case SL_PARAM_ATTRIBUTE: return "attribute";
     case SL_PARAM_TRANSFER: return "transfer_function";
+    case SL_PARAM_VALUES: return "values";
+    case SL_PARAM_TRANSFER_2D: return "transfer_2d";
     }
     return "unknown";
 }

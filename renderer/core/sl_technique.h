@@ -17,7 +17,8 @@
  * state it relies on, draws into the already bound and cleared target
  * (sl_target_begin: reversed-Z depth, GL_GREATER), writes correct depth for
  * opaque surfaces, and leaves the target bound. Errors fill err; a failed
- * prepare leaves *state NULL and nothing allocated.
+ * prepare leaves *state NULL and nothing allocated. Optional members (NULL =
+ * not offered) are left out of a designated initializer.
  */
 #ifndef SL_TECHNIQUE_H
 #define SL_TECHNIQUE_H
@@ -42,6 +43,14 @@ typedef struct sl_render_stats {
     double samples_skipped;  /* ray marchers: samples jumped over by empty-space skipping */
 } sl_render_stats;
 
+/* A named number of a technique's own ("set0.particles"), so callers can
+ * show technique-specific results without branching on its name. */
+#define SL_STATS_EXTRA_MAX 48
+typedef struct sl_stat_value {
+    char name[32];           /* NUL-terminated */
+    double value;
+} sl_stat_value;
+
 /* Where the time of the last prepare went (fill what applies; zero is fine).
  * preprocess_ms + upload_ms need not add up to the pipeline's prepare_ms,
  * which also counts what neither covers. */
@@ -49,7 +58,14 @@ typedef struct sl_prepare_stats {
     double preprocess_ms;    /* CPU work: building meshes, nodes, voxel grids */
     double upload_ms;        /* creating and filling buffers and textures, to a glFinish */
     double gpu_ms;           /* GPU compute passes of the prepare (timer query) */
+    int extra_count;         /* 0 .. SL_STATS_EXTRA_MAX entries of extra in use */
+    sl_stat_value extra[SL_STATS_EXTRA_MAX]; /* fill with sl_prepare_stats_add */
 } sl_prepare_stats;
+
+/* Appends {name, value} to s->extra (technique_stats.c). The name is cut to
+ * 31 bytes; past SL_STATS_EXTRA_MAX entries the value is dropped silently
+ * (a technique's fixed set of names fits, so this is a guard, not a mode). */
+void sl_prepare_stats_add(sl_prepare_stats *s, const char *name, double value);
 
 typedef struct sl_technique {
     const char *name;
@@ -66,10 +82,24 @@ typedef struct sl_technique {
     size_t (*gpu_bytes)(const void *state); /* GPU memory held; may be NULL */
     /* Timings of the prepare that made state; may be NULL (not reported). */
     void (*prepare_stats)(const void *state, sl_prepare_stats *out);
+
+    /* Derived geometry (DESIGN.md "derived data"): the file extension this
+     * technique exports (".csv") and the writer, run on the render thread
+     * after a render (it may read GPU buffers back) with that render's
+     * params. Both NULL: exports nothing (sl_technique_exports). Returns
+     * SL_ERR_IO (cannot write) or SL_ERR_NOMEM; the message names the file. */
+    const char *export_ext;
+    sl_status (*export_geometry)(void *state, const sl_params *params, const char *path, sl_err *err);
 } sl_technique;
 
 /* The registry (sl_registry.c holds the one table). */
 const sl_technique *sl_technique_find(const char *name);
 const sl_technique *const *sl_technique_list(int *count);
+
+/* 1 when t offers export_geometry (with its export_ext), else 0. */
+int sl_technique_exports(const sl_technique *t);
+/* "a, b" (registry order) of the techniques that export, or "none yet";
+ * cut to size, which must be > 0. */
+void sl_technique_exporters(char *list, size_t size);
 
 #endif

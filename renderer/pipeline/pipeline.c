@@ -144,6 +144,22 @@ sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
     return st;
 }
 
+sl_status sl_pipeline_export(sl_pipeline *p, const char *path, sl_err *err)
+{
+    if (!p->technique)
+        return sl_err_set(err, SL_ERR_INVALID, "export %s: no technique selected", path);
+    if (!sl_technique_exports(p->technique)) {
+        char list[256];
+        sl_technique_exporters(list, sizeof list);
+        return sl_err_set(err, SL_ERR_UNSUPPORTED, "technique '%s' exports nothing (export is offered by: %s)",
+                          p->technique->name, list);
+    }
+    if (sl_pipeline_needs_prepare(p))
+        return sl_err_set(err, SL_ERR_INVALID, "export %s: technique '%s' has nothing prepared (render a frame first)",
+                          path, p->technique->name);
+    return p->technique->export_geometry(p->state, &p->params, path, err);
+}
+
 sl_target *sl_pipeline_target(sl_pipeline *p) { return &p->target; }
 
 void sl_pipeline_read_rgba(sl_pipeline *p, uint8_t *rgba, int top_down)

@@ -57,6 +57,15 @@ sl_status sl_pipeline_prepare(sl_pipeline *p, sl_frame_stats *stats, sl_err *err
 sl_status sl_pipeline_render(sl_pipeline *p, const sl_view *view, int samples,
                              sl_frame_stats *stats, sl_err *err);
 
+/* Writes the technique's derived geometry of the last render to path
+ * (sl_technique.export_geometry with the pipeline's params: those of the
+ * last render unless set since), so callers never touch the technique's
+ * state. SL_ERR_UNSUPPORTED when the technique exports nothing (the message
+ * lists the techniques that do), SL_ERR_INVALID when no technique is
+ * selected or a prepare is due (render first); else the
+ * technique's codes (SL_ERR_IO, SL_ERR_NOMEM, naming the file). */
+sl_status sl_pipeline_export(sl_pipeline *p, const char *path, sl_err *err);
+
 /* The target of the last frame (valid until the next render or destroy). */
 sl_target *sl_pipeline_target(sl_pipeline *p);
 

@@ -8,12 +8,16 @@
  * hello a parse error or any other type closes it, a hello opens it; after
  * hello a second hello is refused, a camera goes through
  * sl_msg_camera_check, a set's stream through sl_msg_stream_apply and a
- * set's or scene's params through sl_params_apply_json of every technique.
+ * set's or scene's params through sl_params_apply_json of every technique
+ * and of a private schema holding the types no technique uses yet (values,
+ * transfer_2d).
  * Checks (abort(), so they hold in every build type): a parse gives SL_OK
  * with a type, a tree and NUL-terminated strings within their buffers, or
  * SL_ERR_INVALID with no tree, a code and a message; hello sizes within
  * SL_PROTO_MAX_SIZE; a failed stream or params patch changes nothing and
- * names its field; a passed camera check passes again; a frame header that
+ * names its field; an applied list holds 0 to 4 values in range with zeros
+ * after them, an applied 2D function passes its check with zero unused
+ * widgets; a passed camera check passes again; a frame header that
  * reads matches the input's size. Single-threaded; test-only.
  */
 #include <math.h>
@@ -75,23 +79,60 @@ static void check_stream(const cJSON *patch)
         abort();
 }
 
+/* The list and 2D types next to a number, for check_params. */
+static const sl_param_def private_params[] = {
+    {"isovalues", SL_PARAM_VALUES, -1, 2, {0}, NULL, "data", "a list", SL_INVALIDATE_PREPARED},
+    {"curvature_tf", SL_PARAM_TRANSFER_2D, 0, 0, {SL_TF2D_PRESET_RIDGES_VALLEYS}, NULL, "1/voxel", "2D",
+     SL_INVALIDATE_FRAME},
+    {"spacing", SL_PARAM_FLOAT, 0.25, 16, {1.25}, NULL, "voxel", "a number", SL_INVALIDATE_PREPARED},
+};
+static const sl_technique private_technique = {
+    .name = "private", .description = "fuzz-only", .params = private_params, .param_count = 3,
+};
+
+/* An applied list or 2D function keeps its invariants. */
+static void check_new_types(const sl_params *p, int i)
+{
+    const sl_param_def *d = &p->schema[i];
+    if (d->type == SL_PARAM_VALUES) {
+        int n = p->value_count[i];
+        if (n < 0 || n > SL_PARAM_VALUES_MAX)
+            abort();
+        for (int k = 0; k < SL_PARAM_VALUES_MAX; k++)
+            if (k < n ? !(p->value[i][k] >= d->min && p->value[i][k] <= d->max) : p->value[i][k] != 0.0)
+                abort();
+    } else if (d->type == SL_PARAM_TRANSFER_2D) {
+        sl_err err = {0};
+        if (sl_transfer_function_2d_check(d->name, &p->tf2d, &err) != SL_OK)
+            abort();
+        for (int k = p->tf2d.count; k < SL_TF2D_MAX_WIDGETS; k++)
+            for (int c = 0; c < 7; c++)
+                if (p->tf2d.widget[k][c] != 0.0)
+                    abort();
+    }
+}
+
 static void check_params(const cJSON *patch)
 {
     int n = 0;
     const sl_technique *const *list = sl_technique_list(&n);
-    for (int t = 0; t < n; t++) {
+    for (int t = 0; t <= n; t++) {
+        const sl_technique *tech = t < n ? list[t] : &private_technique;
         sl_params p, before;
-        sl_params_init(&p, list[t]->params, list[t]->param_count);
+        sl_params_init(&p, tech->params, tech->param_count);
         before = p;
         sl_err err = {0};
         if (sl_params_apply_json(&p, patch, &err) != SL_OK) {
             if (p.schema != before.schema || p.count != before.count ||
-                memcmp(p.value, before.value, sizeof p.value) != 0 || !err.message[0])
+                memcmp(p.value, before.value, sizeof p.value) != 0 ||
+                memcmp(p.value_count, before.value_count, sizeof p.value_count) != 0 ||
+                !sl_transfer_function_2d_equal(&p.tf2d, &before.tf2d) || !err.message[0])
                 abort();
             continue;
         }
         for (int i = 0; i < p.count; i++) {
             const sl_param_def *d = &p.schema[i];
+            check_new_types(&p, i);
             int k_count = d->type == SL_PARAM_VEC3 ? 3 : 1;
             for (int k = 0; k < k_count; k++) {
                 double v = p.value[i][k];

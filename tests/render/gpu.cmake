@@ -86,6 +86,18 @@ foreach(case
   gpu_case(NAME cli.${name} EXIT 2 ERR "^sightline-render: ${regex}" ARGS --scene ${GPU_TINY} ${outs})
 endforeach()
 file(MAKE_DIRECTORY ${GPU_OUT}/folder.png)
+# --export on a technique without export_geometry: a usage error once the scene
+# names the technique, before the GPU, listing the techniques that export.
+gpu_case(NAME cli.export_not_offered EXIT 1
+  ERR "^sightline-render: technique 'tubes_mesh' exports nothing \\(--export is offered by: [^)\n]+\\)"
+  ARGS ${GPU_ARGS} --export ${GPU_OUT}/tiny.csv)
+# --stats always holds "prepare_extra", the technique's named numbers: an
+# empty object for volume_dvr, which reports none (a 16^3 volume, 16x16).
+sl_add_render_test(NAME cli.stats_prepare_extra COMMAND ${CMAKE_COMMAND}
+  "-DSTEP1=${GPU_RENDER}|--scene|${CMAKE_CURRENT_SOURCE_DIR}/volume_dvr/composite.json|--set|width=16|--set|height=16|--set|dataset={\"generator\":\"marschner_lobb\",\"size\":16}|--samples|1|--out|${GPU_OUT}/extra.png|--stats|${GPU_OUT}/extra.json"
+  "-DSTEP2=${CMAKE_COMMAND}|-E|cat|${GPU_OUT}/extra.json"
+  "-DOUT2=\"prepare_extra\":[ \t]*{[ \t\n]*}"
+  ${GPU_STEPS})
 # Scene checks (exit 2): the range of elevation, orbit_frames without an orbit.
 gpu_case(NAME cli.elevation_out_of_range EXIT 2
   ERR "^sightline-render: [^\n]*camera\\.orbit\\.elevation must be in \\[-89\\.9, 89\\.9\\] degrees, got 100"

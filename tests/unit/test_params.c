@@ -12,7 +12,13 @@
  * invalidation level, and the typed getters. Attribute indices: the schema
  * range ("none" = -1 only where min is -1), JSON numbers only, and the
  * dataset check (sl_params_check_attributes) word for word; every technique
- * declares `attribute` and `radius_attribute` with that type. No GL.
+ * declares `attribute` and `radius_attribute` with that type. Lists
+ * (values): 0 to 4 numbers, the empty default, a 5th refused, each value's
+ * range with its index named, JSON round trips, compare seeing the count and
+ * each value. 2D transfer functions (transfer_2d): the preset default, JSON
+ * both ways, each kind of bad widget refused naming the widget, equality.
+ * The private schema holds one of each, so both are covered before any
+ * technique declares them. No GL.
  */
 #include <cjson/cJSON.h>
 #include <float.h>
@@ -74,6 +80,11 @@ static int names_range(const char *msg, const sl_param_def *d)
     }
     case SL_PARAM_TRANSFER:
         return strstr(msg, "point") != NULL || strstr(msg, "[[value, r, g, b, a], ...]") != NULL;
+    case SL_PARAM_VALUES:
+        snprintf(range, sizeof range, "[%g, %g]", d->min, d->max);
+        return strstr(msg, range) != NULL;
+    case SL_PARAM_TRANSFER_2D:
+        return strstr(msg, "widget") != NULL;
     }
     return 0;
 }
@@ -157,6 +168,8 @@ static cJSON *other_value(const sl_param_def *d, double out[3])
         return cJSON_CreateString(d->choices[(int)out[0]]);
     }
     case SL_PARAM_TRANSFER: /* test_transfer_parameter */
+    case SL_PARAM_VALUES: /* test_values_parameter */
+    case SL_PARAM_TRANSFER_2D: /* test_transfer_2d_parameter */
         return NULL;
     }
     return NULL;
@@ -183,7 +196,7 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
                  "%s.%s: schema JSON invalidates '%s', declared '%s'", tech, d->name,
                  cJSON_IsString(inv) ? inv->valuestring : "?", invalidation_name(d->invalidates));
     SL_CHECK_MSG(cJSON_IsString(unit) && strcmp(unit->valuestring, d->unit) == 0, "%s.%s: unit", tech, d->name);
-    if (is_numeric(d)) {
+    if (is_numeric(d) || d->type == SL_PARAM_VALUES) {
         const cJSON *mn = cJSON_GetObjectItemCaseSensitive(o, "min"), *mx = cJSON_GetObjectItemCaseSensitive(o, "max");
         SL_CHECK_MSG(cJSON_IsNumber(mn) && cJSON_IsNumber(mx) && mn->valuedouble == d->min && mx->valuedouble == d->max,
                      "%s.%s: schema JSON range", tech, d->name);
@@ -240,6 +253,30 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
             k++;
         }
         SL_CHECK_MSG(maps_ok && !sl_colormap_names[k], "%s.%s: schema JSON colormaps (%d listed)", tech, d->name, k);
+        break;
+    }
+    case SL_PARAM_VALUES: {
+        /* The empty list, and how long a list may be. */
+        const cJSON *mc = cJSON_GetObjectItemCaseSensitive(o, "max_count");
+        def_ok = cJSON_IsArray(def) && cJSON_GetArraySize(def) == 0 && cJSON_IsNumber(mc) &&
+                 mc->valuedouble == SL_PARAM_VALUES_MAX;
+        break;
+    }
+    case SL_PARAM_TRANSFER_2D: {
+        /* The preset def[0], widget by widget, and the widget limit. */
+        sl_transfer_function_2d preset;
+        sl_transfer_function_2d_preset((int)d->def[0], &preset);
+        const cJSON *range = cJSON_GetObjectItemCaseSensitive(def, "range");
+        const cJSON *widgets = cJSON_GetObjectItemCaseSensitive(def, "widgets");
+        const cJSON *mw = cJSON_GetObjectItemCaseSensitive(o, "max_widgets");
+        def_ok = cJSON_IsNumber(range) && range->valuedouble == preset.range && cJSON_IsArray(widgets) &&
+                 cJSON_GetArraySize(widgets) == preset.count && cJSON_IsNumber(mw) &&
+                 mw->valuedouble == SL_TF2D_MAX_WIDGETS;
+        for (int k = 0; def_ok && k < preset.count; k++)
+            for (int c = 0; def_ok && c < 7; c++) {
+                const cJSON *e = cJSON_GetArrayItem(cJSON_GetArrayItem(widgets, k), c);
+                def_ok = cJSON_IsNumber(e) && e->valuedouble == preset.widget[k][c];
+            }
         break;
     }
     }
@@ -348,11 +385,269 @@ static void test_transfer_parameter(const sl_technique *t, int i)
     SL_CHECK(sl_params_set_numbers(&q, d->name, d->def, 1, &err) == SL_ERR_INVALID && strstr(err.message, d->name));
 }
 
+/* Applies the JSON text (for tests) to p; returns the status, err filled. */
+static sl_status apply_text(sl_params *p, const char *name, const char *json, sl_err *err)
+{
+    cJSON *item = cJSON_Parse(json);
+    SL_CHECK_MSG(item != NULL, "bad test JSON %s", json);
+    return item ? apply_one(p, name, item, err) : SL_ERR_INVALID;
+}
+
+/* Expects the JSON text refused for d with a message naming d (quoted) and
+ * holding every `needles` (NULL-ended), and nothing changed. */
+static void expect_text_refused(const sl_params *base, const sl_param_def *d, const char *json,
+                                const char *const *needles)
+{
+    sl_params p = *base;
+    sl_err err = {0};
+    SL_CHECK_MSG(apply_text(&p, d->name, json, &err) == SL_ERR_INVALID, "%s = %s was accepted", d->name, json);
+    char name[80];
+    snprintf(name, sizeof name, "'%s'", d->name);
+    SL_CHECK_MSG(strstr(err.message, name) != NULL, "%s = %s: message '%s' does not name it", d->name, json, err.message);
+    for (int k = 0; needles[k]; k++)
+        SL_CHECK_MSG(strstr(err.message, needles[k]) != NULL, "%s = %s: message '%s' lacks '%s'", d->name, json,
+                     err.message, needles[k]);
+    SL_CHECK_MSG(same_values(&p, base), "%s = %s: a refused patch changed values", d->name, json);
+}
+
+/* Expects sl_params_set_numbers(v, n) refused for d, its message holding every needle, nothing changed. */
+static void expect_values_refused(const sl_params *base, const sl_param_def *d, const double *v, int n,
+                                  const char *const *needles)
+{
+    sl_params p = *base;
+    sl_err err = {0};
+    SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, v, n, &err) == SL_ERR_INVALID, "%s: %d numbers accepted", d->name, n);
+    SL_CHECK_MSG(names_range(err.message, d), "%s: message '%s' does not name it and its range", d->name, err.message);
+    for (int k = 0; needles[k]; k++)
+        SL_CHECK_MSG(strstr(err.message, needles[k]) != NULL, "%s: message '%s' lacks '%s'", d->name, err.message,
+                     needles[k]);
+    SL_CHECK_MSG(same_values(&p, base), "%s: a refused list changed values", d->name);
+}
+
+/* A SL_PARAM_VALUES parameter: the empty default, 0 .. 4 values set,
+ * read back, compared and round-tripped through JSON; a 5th value, a value
+ * out of range (its index named), NaN and non-numbers refused. */
+static void test_values_parameter(const sl_technique *t, int i)
+{
+    const sl_param_def *d = &t->params[i];
+    sl_params base;
+    sl_params_init(&base, t->params, t->param_count);
+    sl_err err = {0};
+    SL_CHECK_MSG(d->unit && d->description && d->description[0], "%s[%d]: unit and description", t->name, i);
+    SL_CHECK_MSG(isfinite(d->min) && isfinite(d->max) && d->min < d->max, "%s.%s: range [%g, %g]", t->name, d->name,
+                 d->min, d->max);
+    double got[SL_PARAM_VALUES_MAX] = {9, 9, 9, 9};
+    SL_CHECK_MSG(sl_params_values(&base, d->name, got) == 0 && got[0] == 0.0 && got[3] == 0.0,
+                 "%s.%s: the default is the empty list", t->name, d->name);
+
+    /* 0 .. 4 values inside the range: stored, read back, reported at the declared level, round-tripped. */
+    double v[SL_PARAM_VALUES_MAX + 1];
+    for (int k = 0; k <= SL_PARAM_VALUES_MAX; k++)
+        v[k] = d->min + (d->max - d->min) * (k + 1) / (SL_PARAM_VALUES_MAX + 2);
+    sl_params prev = base;
+    for (int n = 0; n <= SL_PARAM_VALUES_MAX; n++) {
+        sl_params p = base;
+        SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, n ? v : NULL, n, &err) == SL_OK, "%s.%s: %d values: %s",
+                     t->name, d->name, n, err.message);
+        int count = sl_params_values(&p, d->name, got);
+        SL_CHECK_MSG(count == n, "%s.%s: %d values read back as %d", t->name, d->name, n, count);
+        for (int k = 0; k < SL_PARAM_VALUES_MAX; k++)
+            SL_CHECK(got[k] == (k < n ? v[k] : 0.0));
+        SL_CHECK(sl_params_compare(&base, &p) == (n ? d->invalidates : SL_INVALIDATE_NONE));
+        /* One more value (same first ones) is a change: compare sees the count. */
+        if (n > 0)
+            SL_CHECK_MSG(sl_params_compare(&prev, &p) == d->invalidates, "%s.%s: %d -> %d values not seen", t->name,
+                         d->name, n - 1, n);
+        cJSON *all = sl_params_to_json(&p);
+        const cJSON *mine = cJSON_GetObjectItemCaseSensitive(all, d->name);
+        SL_CHECK(cJSON_IsArray(mine) && cJSON_GetArraySize(mine) == n);
+        for (int k = 0; k < n && cJSON_IsArray(mine); k++)
+            SL_CHECK(cJSON_GetArrayItem(mine, k)->valuedouble == v[k]);
+        sl_params q = base;
+        SL_CHECK_MSG(all && sl_params_apply_json(&q, all, &err) == SL_OK && same_values(&q, &p),
+                     "%s.%s: %d values: no round trip (%s)", t->name, d->name, n, err.message);
+        cJSON_Delete(all);
+        prev = p;
+    }
+    /* A changed value, same count. */
+    sl_params a = base, b = base;
+    SL_CHECK(sl_params_set_numbers(&a, d->name, v, 2, &err) == SL_OK);
+    SL_CHECK(sl_params_set_numbers(&b, d->name, (double[]){v[0], v[2]}, 2, &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == d->invalidates);
+    /* A count alone: [v0] and [v0, 0] hold the same numbers in value[] (unused entries are 0). */
+    if (d->min <= 0.0 && d->max >= 0.0) {
+        SL_CHECK(sl_params_set_numbers(&a, d->name, v, 1, &err) == SL_OK);
+        SL_CHECK(sl_params_set_numbers(&b, d->name, (double[]){v[0], 0.0}, 2, &err) == SL_OK);
+        SL_CHECK_MSG(sl_params_compare(&a, &b) == d->invalidates, "%s.%s: a count change alone not seen", t->name,
+                     d->name);
+    }
+    /* Both ends are valid. */
+    SL_CHECK(sl_params_set_numbers(&a, d->name, (double[]){d->min, d->max}, 2, &err) == SL_OK);
+    /* JSON: [] = auto, a list, and a patch that empties a list again. */
+    sl_params p = base;
+    char text[256];
+    snprintf(text, sizeof text, "[%.17g, %.17g, %.17g]", v[0], v[1], v[2]);
+    SL_CHECK_MSG(apply_text(&p, d->name, text, &err) == SL_OK && sl_params_values(&p, d->name, got) == 3 &&
+                 got[2] == v[2], "%s.%s = %s: %s", t->name, d->name, text, err.message);
+    SL_CHECK(apply_text(&p, d->name, "[]", &err) == SL_OK && sl_params_values(&p, d->name, got) == 0);
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_NONE);
+
+    /* A 5th value, by setter and by JSON: the limit named. */
+    expect_values_refused(&base, d, v, SL_PARAM_VALUES_MAX + 1, (const char *[]){"0 to 4", "got 5", NULL});
+    snprintf(text, sizeof text, "[%.17g, %.17g, %.17g, %.17g, %.17g]", v[0], v[1], v[2], v[3], v[4]);
+    expect_text_refused(&base, d, text, (const char *[]){"at most 4 values", "got 5", NULL});
+    /* Each value's range, the bad one named by its index. */
+    double bad[3] = {v[0], v[1], nextafter(d->max, INFINITY)};
+    expect_values_refused(&base, d, bad, 3, (const char *[]){"value 2", "out of range", NULL});
+    bad[2] = v[2];
+    bad[0] = nextafter(d->min, -INFINITY);
+    expect_values_refused(&base, d, bad, 3, (const char *[]){"value 0", NULL});
+    bad[0] = v[0];
+    bad[1] = NAN;
+    expect_values_refused(&base, d, bad, 2, (const char *[]){"value 1", "finite", NULL});
+    bad[1] = INFINITY;
+    expect_values_refused(&base, d, bad, 2, (const char *[]){"value 1", "finite", NULL});
+    expect_values_refused(&base, d, v, -1, (const char *[]){"got -1", NULL});
+    snprintf(text, sizeof text, "[%.17g, %.17g]", v[0], d->max * 2 + 1);
+    expect_text_refused(&base, d, text, (const char *[]){"value 1", NULL});
+    /* Wrong JSON types: a bare number, a string, a non-number element, null. */
+    snprintf(text, sizeof text, "%.17g", v[0]);
+    expect_text_refused(&base, d, text, (const char *[]){"array", "[] = auto", NULL});
+    expect_text_refused(&base, d, "\"1, 2\"", (const char *[]){"array", NULL});
+    expect_text_refused(&base, d, "null", (const char *[]){"array", NULL});
+    expect_text_refused(&base, d, "{}", (const char *[]){"array", NULL});
+    snprintf(text, sizeof text, "[%.17g, \"x\"]", v[0]);
+    expect_text_refused(&base, d, text, (const char *[]){"value 1", "must be a number", NULL});
+    expect_text_refused(&base, d, "[[0.5]]", (const char *[]){"value 0", NULL});
+    expect_text_refused(&base, d, "[true]", (const char *[]){"value 0", NULL});
+}
+
+/* A widget list of n widgets (JSON) with widget `bad` replaced by bad_widget (when >= 0). */
+static void tf2d_text(char *out, size_t size, int n, int bad, const char *bad_widget, const char *range)
+{
+    snprintf(out, size, "{\"range\": %s, \"widgets\": [", range);
+    for (int k = 0; k < n; k++)
+        snprintf(out + strlen(out), size - strlen(out), "%s%s", k ? ", " : "",
+                 k == bad ? bad_widget : "[0.1, -0.05, 0.2, 0.5, 0.25, 1, 0.75]");
+    snprintf(out + strlen(out), size - strlen(out), "]}");
+}
+
+/* A SL_PARAM_TRANSFER_2D parameter: the preset default; JSON forms apply,
+ * round-trip and report the declared level; each bad widget or shape is
+ * refused naming the widget; equality looks at used widgets only. */
+static void test_transfer_2d_parameter(const sl_technique *t, int i)
+{
+    const sl_param_def *d = &t->params[i];
+    sl_params base;
+    sl_params_init(&base, t->params, t->param_count);
+    sl_err err = {0};
+    SL_CHECK_MSG(d->unit && d->description && d->description[0], "%s[%d]: unit and description", t->name, i);
+    SL_CHECK_MSG(d->def[0] >= 0 && d->def[0] < SL_TF2D_PRESET_COUNT && d->def[0] == floor(d->def[0]),
+                 "%s.%s: def[0] %g is no preset", t->name, d->name, d->def[0]);
+    for (int j = 0; j < t->param_count; j++)
+        SL_CHECK_MSG(j == i || t->params[j].type != SL_PARAM_TRANSFER_2D, "%s: a second transfer_2d entry '%s'",
+                     t->name, t->params[j].name);
+    const sl_transfer_function_2d *def = sl_params_transfer_2d(&base, d->name);
+    sl_transfer_function_2d preset;
+    sl_transfer_function_2d_preset((int)d->def[0], &preset);
+    SL_CHECK_MSG(sl_transfer_function_2d_equal(def, &preset), "%s.%s: default is not the preset", t->name, d->name);
+    SL_CHECK_MSG(sl_transfer_function_2d_check(d->name, def, &err) == SL_OK, "%s.%s: default: %s", t->name, d->name,
+                 err.message);
+
+    char text[4096];
+    const int counts[3] = {1, 5, SL_TF2D_MAX_WIDGETS};
+    for (int g = 0; g < 3; g++) {
+        tf2d_text(text, sizeof text, counts[g], g, "[-0.4, 0.3, 0.01, 0, 0, 0, 0]", g == 2 ? "2.5" : "0.5");
+        sl_params p = base;
+        SL_CHECK_MSG(apply_text(&p, d->name, text, &err) == SL_OK, "%s.%s = %s: %s", t->name, d->name, text,
+                     err.message);
+        const sl_transfer_function_2d *tf = sl_params_transfer_2d(&p, d->name);
+        SL_CHECK(tf->count == counts[g] && tf->range == (g == 2 ? 2.5 : 0.5) && tf->widget[g][0] == -0.4 &&
+                 tf->widget[g][2] == 0.01 && tf->widget[counts[g] - 1][6] == (g == counts[g] - 1 ? 0.0 : 0.75));
+        SL_CHECK_MSG(sl_params_compare(&base, &p) == d->invalidates, "%s.%s = %s: compare", t->name, d->name, text);
+        cJSON *all = sl_params_to_json(&p);
+        sl_params q = base;
+        SL_CHECK_MSG(all && sl_params_apply_json(&q, all, &err) == SL_OK && same_values(&q, &p) &&
+                     sl_transfer_function_2d_equal(sl_params_transfer_2d(&q, d->name), tf),
+                     "%s.%s: %d widgets: no round trip (%s)", t->name, d->name, counts[g], err.message);
+        cJSON_Delete(all);
+    }
+    /* The last widget's alpha alone is a change; so is the range alone. */
+    sl_params a = base, b = base;
+    sl_transfer_function_2d tf = preset;
+    tf.widget[tf.count - 1][6] = 0.25;
+    SL_CHECK(sl_params_set_transfer_2d(&b, d->name, &tf, &err) == SL_OK);
+    SL_CHECK(sl_params_compare(&a, &b) == d->invalidates && !sl_transfer_function_2d_equal(&preset, &tf));
+    tf = preset;
+    tf.range = 0.75;
+    SL_CHECK(sl_params_set_transfer_2d(&b, d->name, &tf, &err) == SL_OK && sl_params_compare(&a, &b) == d->invalidates);
+    /* Widgets past count do not count; -0 is stored as 0. */
+    tf = preset;
+    tf.widget[tf.count][4] = 0.5;
+    SL_CHECK(sl_transfer_function_2d_equal(&preset, &tf));
+    tf.widget[0][1] = -0.0;
+    b = base;
+    SL_CHECK(sl_params_set_transfer_2d(&b, d->name, &tf, &err) == SL_OK);
+    SL_CHECK(sl_params_transfer_2d(&b, d->name)->widget[tf.count][4] == 0.0 &&
+             !signbit(sl_params_transfer_2d(&b, d->name)->widget[0][1]));
+
+    /* Bad widgets, by JSON, each named. */
+    tf2d_text(text, sizeof text, 4, 3, "[0, 0, 0, 1, 1, 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 3: radius 0 must be > 0", NULL});
+    tf2d_text(text, sizeof text, 2, 1, "[0, 0, -0.2, 1, 1, 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 1: radius -0.2", NULL});
+    tf2d_text(text, sizeof text, 2, 0, "[0, 0, 0.2, 1, 1, 1, 1.5]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 0", "alpha 1.5", "[0, 1]", NULL});
+    tf2d_text(text, sizeof text, 3, 2, "[0, 0, 0.2, -0.1, 1, 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 2", "red", NULL});
+    tf2d_text(text, sizeof text, 2, 1, "[1e400, 0, 0.2, 1, 1, 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 1", "k1", "finite", NULL});
+    tf2d_text(text, sizeof text, 2, 1, "[0, 0, 0.2, 1, 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 1", "[k1, k2, radius, r, g, b, a]", NULL});
+    tf2d_text(text, sizeof text, 2, 0, "[0, 0, 0.2, 1, \"x\", 1, 1]", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"widget 0", "numbers", NULL});
+    tf2d_text(text, sizeof text, 2, -1, "", "0");
+    expect_text_refused(&base, d, text, (const char *[]){"range 0", "> 0", NULL});
+    tf2d_text(text, sizeof text, 2, -1, "", "-1");
+    expect_text_refused(&base, d, text, (const char *[]){"range -1", NULL});
+    tf2d_text(text, sizeof text, 2, -1, "", "\"wide\"");
+    expect_text_refused(&base, d, text, (const char *[]){"\"range\"", NULL});
+    tf2d_text(text, sizeof text, SL_TF2D_MAX_WIDGETS + 1, -1, "", "0.5");
+    expect_text_refused(&base, d, text, (const char *[]){"1 to 16 widgets", "got 17", NULL});
+    expect_text_refused(&base, d, "{\"range\": 0.5, \"widgets\": []}", (const char *[]){"1 to 16", "got 0", NULL});
+    expect_text_refused(&base, d, "{\"widgets\": [[0, 0, 0.2, 1, 1, 1, 1]]}", (const char *[]){"\"range\"", NULL});
+    expect_text_refused(&base, d, "{\"range\": 0.5}", (const char *[]){"\"widgets\"", NULL});
+    expect_text_refused(&base, d, "{\"range\": 0.5, \"widgets\": [[0, 0, 0.2, 1, 1, 1, 1]], \"ramp\": 1}",
+                        (const char *[]){"unknown key 'ramp'", NULL});
+    expect_text_refused(&base, d, "[[0, 0, 0.2, 1, 1, 1, 1]]", (const char *[]){"widgets", NULL});
+    expect_text_refused(&base, d, "0.5", (const char *[]){"widgets", NULL});
+    /* The checker alone: count and range. */
+    tf = preset;
+    tf.count = 0;
+    SL_CHECK(sl_transfer_function_2d_check(d->name, &tf, &err) == SL_ERR_INVALID && strstr(err.message, "got 0"));
+    tf = preset;
+    tf.range = NAN;
+    SL_CHECK(sl_transfer_function_2d_check(d->name, &tf, &err) == SL_ERR_INVALID && strstr(err.message, "range"));
+    /* Numbers are refused by the number setter, naming the JSON form. */
+    sl_params q = base;
+    SL_CHECK(sl_params_set_numbers(&q, d->name, d->def, 1, &err) == SL_ERR_INVALID && strstr(err.message, d->name) &&
+             strstr(err.message, "widgets"));
+    SL_CHECK(same_values(&q, &base));
+}
+
 static void test_parameter(const sl_technique *t, int i)
 {
     const sl_param_def *d = &t->params[i];
     if (d->type == SL_PARAM_TRANSFER) {
         test_transfer_parameter(t, i);
+        return;
+    }
+    if (d->type == SL_PARAM_VALUES) {
+        test_values_parameter(t, i);
+        return;
+    }
+    if (d->type == SL_PARAM_TRANSFER_2D) {
+        test_transfer_2d_parameter(t, i);
         return;
     }
     sl_params base;
@@ -363,7 +658,7 @@ static void test_parameter(const sl_technique *t, int i)
     SL_CHECK_MSG(d->name && d->name[0] && d->unit && d->description && d->description[0],
                  "%s[%d]: name, unit and description are required", t->name, i);
     SL_CHECK_MSG(d->invalidates >= SL_INVALIDATE_NONE && d->invalidates <= SL_INVALIDATE_DATASET, "%s.%s", t->name, d->name);
-    SL_CHECK(memcmp(base.value[i], d->def, sizeof base.value[i]) == 0);
+    SL_CHECK(memcmp(base.value[i], d->def, sizeof d->def) == 0 && base.value[i][3] == 0.0 && base.value_count[i] == 0);
     int in_range = 1;
     switch (d->type) {
     case SL_PARAM_VEC3:
@@ -390,6 +685,8 @@ static void test_parameter(const sl_technique *t, int i)
                     d->def[0] < choice_count(d);
         break;
     case SL_PARAM_TRANSFER: /* test_transfer_parameter */
+    case SL_PARAM_VALUES: /* test_values_parameter */
+    case SL_PARAM_TRANSFER_2D: /* test_transfer_2d_parameter */
         break;
     }
     SL_CHECK_MSG(in_range, "%s.%s: default out of its own range", t->name, d->name);
@@ -497,6 +794,8 @@ static void test_parameter(const sl_technique *t, int i)
         break;
     }
     case SL_PARAM_TRANSFER: /* test_transfer_parameter */
+    case SL_PARAM_VALUES:
+    case SL_PARAM_TRANSFER_2D:
         break;
     }
 
@@ -596,9 +895,13 @@ static const sl_param_def test_schema[] = {
     {"v", SL_PARAM_VEC3, -1, 1, {0.1, 0.2, 0.3}, NULL, "rgb", "a vec3", SL_INVALIDATE_FRAME},
     {"a", SL_PARAM_ATTRIBUTE, -1, 3, {0}, NULL, "", "an attribute, -1 = none", SL_INVALIDATE_FRAME},
     {"ra", SL_PARAM_ATTRIBUTE, 0, 3, {1}, NULL, "", "an attribute without none", SL_INVALIDATE_PREPARED},
+    {"iso", SL_PARAM_VALUES, -1, 2, {0}, NULL, "data", "a list of up to 4 values, [] = auto", SL_INVALIDATE_PREPARED},
+    {"ctf", SL_PARAM_TRANSFER_2D, 0, 0, {SL_TF2D_PRESET_RIDGES_VALLEYS}, NULL, "1/voxel", "a 2D transfer function",
+     SL_INVALIDATE_FRAME},
 };
 enum { TEST_COUNT = (int)(sizeof test_schema / sizeof test_schema[0]) };
-static const sl_technique test_tech = {"private", "a private schema", 1, test_schema, TEST_COUNT, NULL, NULL, NULL, NULL, NULL};
+static const sl_technique test_tech = {.name = "private", .description = "a private schema", .dataset_kinds = 1,
+                                        .params = test_schema, .param_count = TEST_COUNT};
 
 static void test_private_schema(void)
 {
@@ -671,6 +974,38 @@ static void test_private_schema(void)
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_ENUM), "enum") == 0);
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_VEC3), "vec3") == 0);
     SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_ATTRIBUTE), "attribute") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_VALUES), "values") == 0);
+    SL_CHECK(strcmp(sl_param_type_name(SL_PARAM_TRANSFER_2D), "transfer_2d") == 0);
+
+    /* The list and the 2D function next to the other types: defaults, a
+     * patch of both, and the preset word for word (the particles default). */
+    sl_params_init(&p, test_schema, TEST_COUNT);
+    double numbers[SL_PARAM_VALUES_MAX];
+    SL_CHECK(sl_params_values(&p, "iso", numbers) == 0);
+    const sl_transfer_function_2d *ctf = sl_params_transfer_2d(&p, "ctf");
+    SL_CHECK(ctf->count == 2 && ctf->range == 0.5);
+    SL_CHECK(ctf->widget[0][0] == 0.25 && ctf->widget[0][1] == 0.0 && ctf->widget[0][2] == 0.3 &&
+             ctf->widget[0][3] == 0.95 && ctf->widget[0][5] == 0.9 && ctf->widget[0][6] == 1.0);
+    SL_CHECK(ctf->widget[1][0] == 0.0 && ctf->widget[1][1] == -0.25 && ctf->widget[1][3] == 0.1 &&
+             ctf->widget[1][6] == 1.0 && ctf->widget[2][6] == 0.0);
+    base = p;
+    patch = cJSON_Parse("{\"iso\": [0.5, -1], \"ctf\": {\"range\": 1, \"widgets\": [[0.5, 0.5, 0.1, 1, 0, 0, 1]]},"
+                        " \"f\": 2}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK);
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_values(&p, "iso", numbers) == 2 && numbers[0] == 0.5 && numbers[1] == -1.0 && numbers[2] == 0.0);
+    SL_CHECK(sl_params_transfer_2d(&p, "ctf")->count == 1 && sl_params_transfer_2d(&p, "ctf")->widget[0][3] == 1.0);
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_PREPARED); /* iso */
+    /* A bad numbers in a patch with a good 2D function: nothing applies. */
+    sl_params before = p;
+    patch = cJSON_Parse("{\"ctf\": {\"range\": 2, \"widgets\": [[0, 0, 0.1, 1, 1, 1, 1]]}, \"iso\": [0, 1, 2, 3]}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_ERR_INVALID && strstr(err.message, "'iso'") &&
+             strstr(err.message, "value 3 = 3") && strstr(err.message, "[-1, 2] data"));
+    cJSON_Delete(patch);
+    SL_CHECK(same_values(&p, &before) && sl_params_transfer_2d(&p, "ctf")->range == 1.0);
+    /* set_transfer_2d on another type, and an unknown name. */
+    SL_CHECK(sl_params_set_transfer_2d(&p, "f", ctf, &err) == SL_ERR_INVALID && strstr(err.message, "'f'"));
+    SL_CHECK(sl_params_set_transfer_2d(&p, "nope", ctf, &err) == SL_ERR_INVALID && strstr(err.message, "'nope'"));
 
     /* A concrete message, word for word where it matters. */
     sl_params_init(&p, test_schema, TEST_COUNT);

@@ -11,7 +11,10 @@
  * dataset re-prepares. sl_frame_stats.prepared is what is checked.
  * Also: with orbit_frames = 4, frame 2's view and image equal those of a
  * single frame at azimuth + 180 (and differ from frame 0's) — the scene
- * view the CLI's --frames uses. Needs a GL 4.5 context (llvmpipe in CI;
+ * view the CLI's --frames uses. sl_pipeline_export: refused before a
+ * prepare and for a technique without the hook (naming the exporters);
+ * a private exporting technique gets its own state, the params of the last
+ * render and the path. Needs a GL 4.5 context (llvmpipe in CI;
  * never skipped: no context is a failure). Single-threaded (render thread).
  */
 #include <math.h>
@@ -81,11 +84,13 @@ static double moved_number(const sl_param_def *d, double v)
 }
 
 /* Moves parameter i of p to a different valid value; returns 0 if the
- * setter refused it (a test failure: the value was chosen inside the schema). */
-static int move_param(sl_params *p, int i, sl_err *err)
+ * setter refused it (a test failure: the value was chosen inside the schema).
+ * ds gives an empty VALUES list its first value: the middle of a volume's
+ * value range (the schema's middle, 0 of +-1e30, may lie outside the data). */
+static int move_param(sl_params *p, int i, const sl_dataset *ds, sl_err *err)
 {
     const sl_param_def *d = &p->schema[i];
-    double v[3] = {p->value[i][0], p->value[i][1], p->value[i][2]};
+    double v[SL_PARAM_VALUES_MAX] = {p->value[i][0], p->value[i][1], p->value[i][2], p->value[i][3]};
     int n = 1;
     switch (d->type) {
     case SL_PARAM_BOOL:
@@ -123,6 +128,23 @@ static int move_param(sl_params *p, int i, sl_err *err)
         int last = tf.count - 1, alpha = tf.colormap >= 0 ? 1 : 4;
         tf.point[last][alpha] = tf.point[last][alpha] > 0.5 ? 0.25 : 0.75;
         return sl_params_set_transfer(p, d->name, &tf, err) == SL_OK;
+    }
+    case SL_PARAM_VALUES:
+        /* An empty list (auto) becomes one value; else the first value moves like a number. */
+        n = p->value_count[i];
+        if (n == 0) {
+            v[0] = ds->kind == SL_DATASET_LINES ? 0.5 * (d->min + d->max)
+                                                : 0.5 * (ds->volume.value_min + ds->volume.value_max);
+            n = 1;
+        } else {
+            v[0] = moved_number(d, v[0]);
+        }
+        break;
+    case SL_PARAM_TRANSFER_2D: {
+        sl_transfer_function_2d tf = *sl_params_transfer_2d(p, d->name);
+        double *alpha = &tf.widget[tf.count - 1][6];
+        *alpha = *alpha > 0.5 ? 0.25 : 0.75;
+        return sl_params_set_transfer_2d(p, d->name, &tf, err) == SL_OK;
     }
     }
     return sl_params_set_numbers(p, d->name, v, n, err) == SL_OK;
@@ -187,7 +209,7 @@ static void test_technique(sl_gpu *gpu, const sl_technique *t)
             single_choice++; /* an enum of one choice (ribbons' pipeline today) has nothing to move to */
             continue;
         }
-        if (!move_param(&params, i, &err)) {
+        if (!move_param(&params, i, pds, &err)) {
             SL_CHECK_MSG(0, "%s: cannot move parameter '%s': %s", t->name, d->name, err.message);
             continue;
         }
@@ -330,6 +352,115 @@ static void test_orbit_frames(sl_gpu *gpu)
     sl_scene_deinit(&b);
 }
 
+/* ---- sl_pipeline_export ------------------------------------------------------ */
+
+/* A private technique that draws nothing and exports what it was given; its
+ * schema also holds the list and 2D types no registered technique uses yet,
+ * so test_technique's moves cover them. */
+static const sl_param_def exporter_params[] = {
+    {"level", SL_PARAM_FLOAT, 0, 10, {1}, NULL, "", "a frame-level number the export reads", SL_INVALIDATE_FRAME},
+    {"isovalues", SL_PARAM_VALUES, -1e30, 1e30, {0}, NULL, "data", "a list, [] = auto", SL_INVALIDATE_PREPARED},
+    {"curvature_tf", SL_PARAM_TRANSFER_2D, 0, 0, {SL_TF2D_PRESET_RIDGES_VALLEYS}, NULL, "1/voxel", "a 2D function",
+     SL_INVALIDATE_FRAME},
+};
+typedef struct exporter_state {
+    int exports;
+    double level;
+    char path[256];
+} exporter_state;
+
+static sl_status exporter_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **state, sl_err *err)
+{
+    (void)gpu, (void)ds, (void)params;
+    *state = calloc(1, sizeof(exporter_state));
+    return *state ? SL_OK : sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+}
+
+static sl_status exporter_render(void *state, const sl_view *view, const sl_params *params, sl_target *target,
+                                 sl_render_stats *stats, sl_err *err)
+{
+    (void)state, (void)view, (void)params, (void)target, (void)stats, (void)err;
+    return SL_OK;
+}
+
+static sl_status exporter_export(void *state, const sl_params *params, const char *path, sl_err *err)
+{
+    exporter_state *s = state;
+    if (strstr(path, "unwritable"))
+        return sl_err_set(err, SL_ERR_IO, "cannot write %s", path);
+    s->exports++;
+    s->level = sl_params_float(params, "level");
+    snprintf(s->path, sizeof s->path, "%s", path);
+    return SL_OK;
+}
+
+static exporter_state *last_exporter_state;
+static void exporter_release(void *state)
+{
+    if (state == last_exporter_state)
+        last_exporter_state = NULL;
+    free(state);
+}
+
+static void exporter_stats(const void *state, sl_prepare_stats *out)
+{
+    last_exporter_state = (exporter_state *)state; /* the test's window on the state */
+    *out = (sl_prepare_stats){0};
+    sl_prepare_stats_add(out, "exporter.prepared", 1.0);
+}
+
+static const sl_technique exporter = {
+    .name = "exporter", .description = "test-only: exports what it is given", .dataset_kinds = SL_DATASET_VOLUME,
+    .params = exporter_params, .param_count = 3, .prepare = exporter_prepare, .render = exporter_render,
+    .release = exporter_release, .prepare_stats = exporter_stats, .export_ext = ".txt",
+    .export_geometry = exporter_export,
+};
+
+static void test_export(sl_gpu *gpu)
+{
+    sl_err err = {0};
+    sl_pipeline *pipe = NULL;
+    sl_dataset *ds = make_dataset(SL_DATASET_VOLUME, &err);
+    SL_CHECK(ds && sl_pipeline_create(gpu, &pipe, &err) == SL_OK);
+    if (!ds || !pipe) {
+        sl_dataset_destroy(ds);
+        return;
+    }
+    SL_CHECK(sl_pipeline_export(pipe, "x.txt", &err) == SL_ERR_INVALID && strstr(err.message, "no technique"));
+    sl_pipeline_set_dataset(pipe, ds);
+    sl_view view;
+    SL_CHECK(make_view(sl_pipeline_dataset(pipe), 30.0, W, H, &view, &err) == SL_OK);
+
+    /* A registered technique without the hook: refused, naming the ones that export. */
+    const sl_technique *dvr = sl_technique_find("volume_dvr");
+    sl_params params;
+    sl_params_init(&params, dvr->params, dvr->param_count);
+    SL_CHECK(sl_pipeline_set_technique(pipe, dvr, &params, &err) == SL_OK);
+    SL_CHECK(render(pipe, &view, 1, "before export", dvr->name) == 1);
+    sl_status st = sl_pipeline_export(pipe, "x.csv", &err);
+    SL_CHECK_MSG(st == SL_ERR_UNSUPPORTED && strstr(err.message, "technique 'volume_dvr' exports nothing") &&
+                 strstr(err.message, "export is offered by: "), "%d: %s", (int)st, err.message);
+
+    /* The private exporter: nothing prepared yet, then the state, the params and the path. */
+    sl_params_init(&params, exporter_params, 3);
+    SL_CHECK(sl_pipeline_set_technique(pipe, &exporter, &params, &err) == SL_OK);
+    SL_CHECK(sl_pipeline_export(pipe, "x.txt", &err) == SL_ERR_INVALID && strstr(err.message, "render a frame first"));
+    sl_frame_stats stats;
+    SL_CHECK(sl_pipeline_render(pipe, &view, 1, &stats, &err) == SL_OK && stats.prepared);
+    SL_CHECK(stats.prepare_reported && stats.prepare.extra_count == 1 &&
+             strcmp(stats.prepare.extra[0].name, "exporter.prepared") == 0 && stats.prepare.extra[0].value == 1.0);
+    exporter_state *s = last_exporter_state;
+    SL_CHECK(s != NULL);
+    SL_CHECK(sl_params_set_numbers(&params, "level", (double[]){2.5}, 1, &err) == SL_OK);
+    SL_CHECK(sl_pipeline_set_technique(pipe, &exporter, &params, &err) == SL_OK); /* frame level: no prepare due */
+    SL_CHECK_MSG(sl_pipeline_export(pipe, "out/geometry.txt", &err) == SL_OK, "%s", err.message);
+    SL_CHECK(s && s->exports == 1 && s->level == 2.5 && strcmp(s->path, "out/geometry.txt") == 0);
+    SL_CHECK(sl_pipeline_export(pipe, "unwritable.txt", &err) == SL_ERR_IO && strstr(err.message, "unwritable.txt"));
+    SL_CHECK(s && s->exports == 1);
+    sl_pipeline_destroy(pipe);
+    SL_CHECK(last_exporter_state == NULL); /* released with the pipeline */
+}
+
 int main(void)
 {
     sl_err err = {0};
@@ -346,6 +477,8 @@ int main(void)
         test_prepare_gl_error(gpu, list[i]);
     }
     test_orbit_frames(gpu);
+    test_export(gpu);
+    test_technique(gpu, &exporter); /* the re-prepare rule for values and transfer_2d */
     sl_gpu_destroy(gpu);
     SL_TEST_END();
 }
