@@ -11,7 +11,8 @@
  * differentiated signed distance; shape index and reliability limits. Nearest point on an
  * ellipsoid (residual, orthogonality, brute force, degenerate points), areas against the
  * spheroid closed forms, NN statistics (hexagonal patch, grid = brute force), placement
- * counts on hand-made volumes, and the CSV reader's round trip and each error. CPU only.
+ * counts on hand-made volumes, the CSV reader's round trip and each error, and the references
+ * on gen_ellipsoid's f32/u16 data (seed count, isovalue in data units, curvature). CPU only.
  */
 #include <math.h>
 #include <stdint.h>
@@ -20,6 +21,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "data/sl_generate.h"
 #include "particles_reference.h"
 #include "sl_test.h"
 
@@ -836,6 +838,65 @@ static void test_csv(void)
     SL_CHECK(pref_csv_read(csv_path, &rows, &count, err, sizeof err) == -1 && rows == NULL && strstr(err, "cannot open"));
 }
 
+/* ---- with the ellipsoid generator ---- */
+
+static sl_dataset *generate(const char *json)
+{
+    sl_dataset *ds = NULL;
+    sl_err err = {0};
+    SL_CHECK_MSG(sl_generate_json(json, &ds, &err) == SL_OK, "%s: %s", json, err.message);
+    return ds;
+}
+
+/* The references on gen_ellipsoid's data: the seed count against 1.5·A/h² for a sphere, the u16
+ * isovalue mapping of the generator's header, and B-spline curvature (voxel → world) against the
+ * analytic ellipsoid on an anisotropic grid. */
+static void test_on_generated(void)
+{
+    sl_dataset *f32 = generate("{\"generator\":\"ellipsoid\",\"size\":65}");
+    sl_dataset *u16 = generate("{\"generator\":\"ellipsoid\",\"size\":65,\"voxel_type\":\"u16\"}");
+    if (f32 && u16) {
+        /* iso 0.5: a sphere of radius (1 − 0.5)·0.6 = 0.3, h = 1/32 world. */
+        uint64_t n_f = pref_placement_count(&f32->volume, 0.5, 1.0);
+        uint64_t n_u = pref_placement_count(&u16->volume, (0.5 + 1.5) / 2.5 * 65535.0, 1.0);
+        double expect = 1.5 * pref_sphere_area(0.3) * 32.0 * 32.0;
+        printf("ellipsoid sphere r 0.3 at 65^3: %llu seeds f32, %llu u16, 1.5 A/h^2 = %.0f\n", (unsigned long long)n_f,
+               (unsigned long long)n_u, expect);
+        SL_CHECK(fabs((double)n_f - expect) < 0.03 * expect);
+        SL_CHECK(llabs((long long)n_f - (long long)n_u) <= 5);
+        SL_CHECK(pref_placement_count(&f32->volume, 0.25, 2.0) > 0);
+    }
+    sl_dataset_destroy(f32);
+    sl_dataset_destroy(u16);
+
+    sl_dataset *ds = generate("{\"generator\":\"ellipsoid\",\"size\":97,\"a\":0.8,\"b\":0.6,\"c\":0.5,\"anisotropy\":2}");
+    if (ds) {
+        const double axes[3] = {0.8 * 0.75, 0.6 * 0.75, 0.5 * 0.75}; /* iso 0.25 */
+        const double org[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
+        uint64_t rng = 4;
+        double worst = 0.0, worst_f = 0.0;
+        for (int s = 0; s < 200; s++) {
+            double th = 0.2 + 2.7 * uniform(&rng), ph = 2 * PI * uniform(&rng);
+            double p[3] = {axes[0] * sin(th) * cos(ph), axes[1] * sin(th) * sin(ph), axes[2] * cos(th)}, u[3];
+            for (int a = 0; a < 3; a++)
+                u[a] = (p[a] - org[a]) / ds->volume.spacing[a];
+            double f, g[3], H[9], k1, k2, r1, r2, ft;
+            SL_CHECK(pref_bspline(&ds->volume, u, &f, g, H) == 0);
+            SL_CHECK(pref_trilinear(&ds->volume, u, &ft, NULL) == 0);
+            worst_f = fmax(worst_f, fabs(ft - 0.25));
+            pref_voxel_to_world(ds->volume.spacing, g, H, g, H);
+            SL_CHECK(pref_curvature(g, H, &k1, &k2, NULL) == 0);
+            SL_CHECK(pref_ellipsoid_curvature(axes, p, &r1, &r2, NULL) == 0);
+            worst = fmax(worst, fmax(fabs(k1 - r1) / r1, fabs(k2 - r2) / r2));
+        }
+        printf("B-spline curvature on a 97x97x49 ellipsoid (iso 0.25): worst rel %.3g; trilinear |f - iso| %.3g\n",
+               worst, worst_f);
+        SL_CHECK(worst < 0.02);   /* measured 0.5 % */
+        SL_CHECK(worst_f < 0.005); /* measured 0.0013 */
+    }
+    sl_dataset_destroy(ds);
+}
+
 int main(void)
 {
     test_bspline_weights();
@@ -851,5 +912,6 @@ int main(void)
     test_nn();
     test_placement_count();
     test_csv();
+    test_on_generated();
     SL_TEST_END();
 }
