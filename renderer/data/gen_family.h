@@ -57,5 +57,6 @@ extern const sl_gen_family sl_gen_random_walk;
 extern const sl_gen_family sl_gen_marschner_lobb;
 extern const sl_gen_family sl_gen_torus;
 extern const sl_gen_family sl_gen_head;
+extern const sl_gen_family sl_gen_ellipsoid;
 
 #endif

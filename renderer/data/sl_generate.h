@@ -2,14 +2,14 @@
  *
  * A generator call is a JSON object {"generator": NAME, ...keys}; each family
  * declares its keys (a size key so benchmarks can sweep data size, and
- * "seed"); an unknown key, a wrong type or an out-of-range value is an error
+ * "seed" where it has randomness); an unknown key, a wrong type or an out-of-range value is an error
  * naming it. Same call, same bytes, on every run of a build (own PRNG, no
  * libc rand, no time). Across machines the counts and line structure are
  * identical and the values agree up to libm's last-bit rounding (sin, cos,
  * exp may differ by an ulp between libm versions or with FMA); test_generate
  * pins both per family.
  * Families — lines: tornado, abc, bundle, furball, hotroom, random_walk;
- *            volumes: marschner_lobb, torus, head.
+ *            volumes: marschner_lobb, torus, head, ellipsoid.
  * Any thread; no GL.
  */
 #ifndef SL_GENERATE_H

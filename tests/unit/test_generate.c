@@ -3,7 +3,8 @@
  * Checks determinism (same call -> identical bytes, other seed -> other
  * bytes), counts against the keys, finiteness, the fields against
  * independent double-precision transcriptions of their formulas (tornado,
- * ABC, Marschner–Lobb, torus), the RK4 tracer against an exact circle, the
+ * ABC, Marschner–Lobb, torus, ellipsoid with its u16/u8 mapping, anisotropy,
+ * slices, plateau and sheet), the RK4 tracer against an exact circle, the
  * hotroom radius/segment invariant, key errors naming the key, and runs
  * bin/sightline-info as a process (SIGHTLINE_BINARY_DIR) on a generator call.
  * Bounds: float storage of positions (~1e-7 relative) dominates every
@@ -817,6 +818,178 @@ static void test_volumes(void)
     sl_dataset_destroy(ds);
 }
 
+/* The ellipsoid's f by its formula, independent of gen_ellipsoid.c's loops. */
+static double ellipsoid_f(double x, double y, double z, double a, double b, double c)
+{
+    return 1.0 - sqrt((x / a) * (x / a) + (y / b) * (y / b) + (z / c) * (z / c));
+}
+
+/* World position of voxel (i, j, k) from the dataset's own origin and spacing. */
+static void voxel_world(const sl_dataset *ds, int i, int j, int k, double p[3])
+{
+    p[0] = ds->origin.x + i * ds->volume.spacing[0];
+    p[1] = ds->origin.y + j * ds->volume.spacing[1];
+    p[2] = ds->origin.z + k * ds->volume.spacing[2];
+}
+
+/* Largest |stored - expected| over the whole grid, expected = map(f(x)). */
+static double ellipsoid_worst(const sl_dataset *ds, double a, double b, double c, double levels)
+{
+    const sl_volume *v = &ds->volume;
+    double worst = 0.0;
+    for (int k = 0; k < v->dims[2]; k++)
+        for (int j = 0; j < v->dims[1]; j++)
+            for (int i = 0; i < v->dims[0]; i++) {
+                double p[3];
+                voxel_world(ds, i, j, k, p);
+                double f = ellipsoid_f(p[0], p[1], p[2], a, b, c);
+                double want = f;
+                if (levels > 0.0)
+                    want = (fmin(fmax(f, -1.5), 1.0) + 1.5) / 2.5 * levels;
+                worst = fmax(worst, fabs(sl_volume_value(v, i, j, k, 0) - want));
+            }
+    return worst;
+}
+
+static void test_ellipsoid(void)
+{
+    /* Defaults: 64^3 f32 sphere of radius 0.6 on [-1, 1]^3. */
+    sl_dataset *ds = gen("{\"generator\":\"ellipsoid\"}");
+    if (ds) {
+        const sl_volume *v = &ds->volume;
+        SL_CHECK(v->type == SL_VOXEL_F32 && v->dims[0] == 64 && v->dims[1] == 64 && v->dims[2] == 64);
+        SL_CHECK_NEAR(v->spacing[2], 2.0 / 63.0, 1e-15);
+        SL_CHECK_NEAR(ds->bounds_min.z, -1.0, 1e-12);
+        SL_CHECK_NEAR(ds->bounds_max.z, 1.0, 1e-12);
+        SL_CHECK_NEAR(ellipsoid_worst(ds, 0.6, 0.6, 0.6, 0.0), 0.0, 1e-6);
+    }
+    sl_dataset_destroy(ds);
+
+    /* Distinct axes, odd size so voxel 32 is the centre; the axes must not be swapped. */
+    ds = gen("{\"generator\":\"ellipsoid\",\"size\":65,\"a\":0.5,\"b\":0.4,\"c\":0.25}");
+    if (ds) {
+        const sl_volume *v = &ds->volume;
+        SL_CHECK_NEAR(sl_volume_value(v, 32, 32, 32, 0), 1.0, 0.0);
+        /* 16 voxels = 0.5 along each axis: f = 1 - 0.5 / axis. */
+        SL_CHECK_NEAR(sl_volume_value(v, 48, 32, 32, 0), 0.0, 1e-6);
+        SL_CHECK_NEAR(sl_volume_value(v, 32, 48, 32, 0), 1.0 - 0.5 / 0.4, 1e-6);
+        SL_CHECK_NEAR(sl_volume_value(v, 32, 32, 48, 0), 1.0 - 0.5 / 0.25, 1e-6);
+        SL_CHECK_NEAR(sl_volume_value(v, 16, 32, 32, 0), 0.0, 1e-6);
+        SL_CHECK_NEAR(sl_volume_value(v, 40, 32, 32, 0), 0.5, 1e-6);  /* x = 0.25: iso 0.5 at semi-axis (1 - 0.5) a */
+        SL_CHECK_NEAR(ellipsoid_worst(ds, 0.5, 0.4, 0.25, 0.0), 0.0, 1e-6);
+        SL_CHECK_NEAR(v->value_max, 1.0, 0.0);
+    }
+    sl_dataset_destroy(ds);
+
+    /* u16 / u8: the integers round((clamp(f, -1.5, 1) + 1.5) / 2.5 M); the clamp is reached at the corners. */
+    static const struct { const char *call; sl_voxel_type type; double levels; } quant[] = {
+        {"{\"generator\":\"ellipsoid\",\"size\":33,\"a\":0.375,\"b\":0.5,\"c\":0.7,\"voxel_type\":\"u16\"}", SL_VOXEL_U16, 65535.0},
+        {"{\"generator\":\"ellipsoid\",\"size\":33,\"a\":0.375,\"b\":0.5,\"c\":0.7,\"voxel_type\":\"u8\"}", SL_VOXEL_U8, 255.0},
+    };
+    for (int q = 0; q < 2; q++) {
+        ds = gen(quant[q].call);
+        if (!ds)
+            continue;
+        const sl_volume *v = &ds->volume;
+        SL_CHECK(v->type == quant[q].type);
+        SL_CHECK_MSG(ellipsoid_worst(ds, 0.375, 0.5, 0.7, quant[q].levels) <= 0.5 + 1e-9, "%s", quant[q].call);
+        SL_CHECK_NEAR(sl_volume_value(v, 16, 16, 16, 0), quant[q].levels, 0.0);  /* f = 1 */
+        SL_CHECK_NEAR(v->value_min, 0.0, 0.0);                                   /* f <= -1.5 */
+        SL_CHECK_NEAR(v->value_max, quant[q].levels, 0.0);
+        /* x = 0.375 = a: f = 0 -> 1.5 / 2.5 M (39321 u16, 153 u8), and the documented iso 0.5 -> 0.8 M. */
+        SL_CHECK_NEAR(sl_volume_value(v, 16 + 6, 16, 16, 0), round(0.6 * quant[q].levels), 0.0);
+        SL_CHECK_NEAR((0.5 + 1.5) / 2.5 * quant[q].levels, q == 0 ? 52428.0 : 204.0, 1e-9);
+        sl_dataset_destroy(ds);
+    }
+
+    /* Anisotropy: z spacing and slice count, centred slices, f in world units. */
+    static const struct { double an; int size, dims_z; } aniso[] = {
+        {2.0, 65, 33}, {3.0, 65, 22}, {0.5, 33, 65}, {0.25, 9, 33}, {4.0, 8, 3},
+    };
+    for (size_t t = 0; t < sizeof aniso / sizeof aniso[0]; t++) {
+        char call[160];
+        snprintf(call, sizeof call, "{\"generator\":\"ellipsoid\",\"size\":%d,\"anisotropy\":%g,\"c\":0.4}", aniso[t].size,
+                 aniso[t].an);
+        ds = gen(call);
+        if (!ds)
+            continue;
+        const sl_volume *v = &ds->volume;
+        double h = 2.0 / (aniso[t].size - 1);
+        SL_CHECK_MSG(v->dims[0] == aniso[t].size && v->dims[1] == aniso[t].size && v->dims[2] == aniso[t].dims_z,
+                     "%s: dims %d %d %d", call, v->dims[0], v->dims[1], v->dims[2]);
+        SL_CHECK_MSG(fabs(v->spacing[0] - h) < 1e-15 && fabs(v->spacing[2] - aniso[t].an * h) < 1e-15, "%s: spacing", call);
+        SL_CHECK_NEAR(ds->origin.z, -0.5 * (aniso[t].dims_z - 1) * aniso[t].an * h, 1e-12);
+        SL_CHECK_NEAR(ds->bounds_min.z + ds->bounds_max.z, 0.0, 1e-12);
+        SL_CHECK_NEAR(ellipsoid_worst(ds, 0.6, 0.6, 0.4, 0.0), 0.0, 1e-6);
+        sl_dataset_destroy(ds);
+    }
+
+    /* slices: exactly that many; 1 is one slice at z = 0 holding the equator. */
+    ds = gen("{\"generator\":\"ellipsoid\",\"size\":33,\"slices\":1}");
+    if (ds) {
+        const sl_volume *v = &ds->volume;
+        SL_CHECK(v->dims[0] == 33 && v->dims[2] == 1);
+        SL_CHECK_NEAR(ds->origin.z, 0.0, 0.0);
+        SL_CHECK_NEAR(sl_volume_value(v, 16, 16, 0, 0), 1.0, 0.0);
+        SL_CHECK_NEAR(ellipsoid_worst(ds, 0.6, 0.6, 0.6, 0.0), 0.0, 1e-6);
+    }
+    sl_dataset_destroy(ds);
+    ds = gen("{\"generator\":\"ellipsoid\",\"size\":33,\"slices\":5,\"anisotropy\":2}");
+    if (ds) {
+        SL_CHECK(ds->volume.dims[2] == 5);
+        SL_CHECK_NEAR(ds->origin.z, -2.0 * 2.0 * (2.0 / 32.0), 1e-15);
+        SL_CHECK_NEAR(sl_volume_value(&ds->volume, 16, 16, 2, 0), 1.0, 0.0);
+    }
+    sl_dataset_destroy(ds);
+
+    /* plateau: the linear field where above 0.5, exactly 0.5 elsewhere. */
+    ds = gen("{\"generator\":\"ellipsoid\",\"size\":33,\"profile\":\"plateau\"}");
+    if (ds) {
+        const sl_volume *v = &ds->volume;
+        SL_CHECK_NEAR(v->value_min, 0.5, 0.0);
+        SL_CHECK_NEAR(sl_volume_value(v, 0, 0, 0, 0), 0.5, 0.0);
+        SL_CHECK_NEAR(sl_volume_value(v, 16, 16, 16, 0), 1.0, 0.0);
+        SL_CHECK_NEAR(sl_volume_value(v, 16 + 2, 16, 16, 0), 1.0 - 0.125 / 0.6, 1e-6);
+        SL_CHECK_NEAR(sl_volume_value(v, 16 + 6, 16, 16, 0), 0.5, 0.0);  /* q = 0.625 */
+        size_t flat = 0, n = 33 * 33 * 33;
+        for (size_t i = 0; i < n; i++)
+            flat += ((const float *)v->data)[i] == 0.5f;
+        SL_CHECK(flat > n / 2);
+    }
+    sl_dataset_destroy(ds);
+
+    /* sheet: 1 on one slice inside the ellipse (x/a)^2 + (y/b)^2 <= 1, 0 elsewhere; odd and even slice counts. */
+    static const struct { const char *call; int dims_z, slice; double a, b; } sheets[] = {
+        {"{\"generator\":\"ellipsoid\",\"size\":33,\"profile\":\"sheet\",\"a\":0.7,\"b\":0.4}", 33, 16, 0.7, 0.4},
+        {"{\"generator\":\"ellipsoid\",\"size\":32,\"profile\":\"sheet\",\"a\":0.7,\"b\":0.4}", 32, 15, 0.7, 0.4},
+        {"{\"generator\":\"ellipsoid\",\"size\":33,\"profile\":\"sheet\",\"slices\":1}", 1, 0, 0.6, 0.6},
+    };
+    for (size_t t = 0; t < sizeof sheets / sizeof sheets[0]; t++) {
+        ds = gen(sheets[t].call);
+        if (!ds)
+            continue;
+        const sl_volume *v = &ds->volume;
+        SL_CHECK(v->dims[2] == sheets[t].dims_z);
+        size_t wrong = 0, ones = 0;
+        for (int k = 0; k < v->dims[2]; k++)
+            for (int j = 0; j < v->dims[1]; j++)
+                for (int i = 0; i < v->dims[0]; i++) {
+                    double p[3];
+                    voxel_world(ds, i, j, k, p);
+                    double e = (p[0] / sheets[t].a) * (p[0] / sheets[t].a) + (p[1] / sheets[t].b) * (p[1] / sheets[t].b);
+                    double want = k == sheets[t].slice && e <= 1.0 ? 1.0 : 0.0;
+                    double got = sl_volume_value(v, i, j, k, 0);
+                    wrong += got != want && fabs(e - 1.0) > 1e-9;
+                    ones += got == 1.0;
+                }
+        SL_CHECK_MSG(wrong == 0, "%s: %zu voxels differ", sheets[t].call, wrong);
+        /* The disk's area pi a b in voxels of (2 / (size - 1))^2, to 5 %. */
+        double h = v->spacing[0], area = PI * sheets[t].a * sheets[t].b / (h * h);
+        SL_CHECK_MSG(fabs((double)ones - area) < 0.05 * area, "%s: %zu ones, disk %.0f", sheets[t].call, ones, area);
+        sl_dataset_destroy(ds);
+    }
+}
+
 /* An error: status INVALID or LIMIT, *out NULL, message containing every needle. */
 static void expect_error(const char *json, sl_status want, const char *n1, const char *n2)
 {
@@ -849,6 +1022,10 @@ static void test_errors(void)
     expect_error("{\"generator\":\"marschner_lobb\",\"size\":7}", I, "'size'", "8..512");
     expect_error("{\"generator\":\"head\",\"voxel_type\":\"f64\"}", I, "'voxel_type'", "\"u8\"");
     expect_error("{\"generator\":\"head\",\"voxel_type\":8}", I, "'voxel_type'", "a number");
+    expect_error("{\"generator\":\"ellipsoid\",\"profile\":\"cube\"}", I, "'profile'", "\"sheet\"");
+    expect_error("{\"generator\":\"ellipsoid\",\"a\":0.01}", I, "'a'", "0.05..0.95");
+    expect_error("{\"generator\":\"ellipsoid\",\"anisotropy\":5}", I, "'anisotropy'", "0.25..4");
+    expect_error("{\"generator\":\"ellipsoid\",\"seed\":1}", I, "'seed'", "profile");
     expect_error("{\"generator\":\"volcano\"}", I, "volcano", "tornado");
     expect_error("{\"generator\":7}", I, "'generator'", NULL);
     expect_error("{\"lines\":7}", I, "'generator'", NULL);
@@ -869,11 +1046,11 @@ static void test_catalog(void)
 {
     int n = 0;
     const sl_generator_info *g = sl_generator_list(&n);
-    SL_CHECK(n == 9);
+    SL_CHECK(n == 10);
     static const sl_gen_family *fams[] = {&sl_gen_tornado, &sl_gen_abc,           &sl_gen_bundle,
                                           &sl_gen_furball, &sl_gen_hotroom,       &sl_gen_random_walk,
-                                          &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head};
-    for (int i = 0; i < 9; i++) {
+                                          &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head, &sl_gen_ellipsoid};
+    for (int i = 0; i < 10; i++) {
         int listed = 0;
         for (int j = 0; j < n; j++)
             listed |= strcmp(g[j].name, fams[i]->name) == 0 && g[j].kind == fams[i]->kind;
@@ -893,7 +1070,9 @@ static void test_catalog(void)
                 SL_CHECK_MSG(fams[i]->keys[k].def >= fams[i]->keys[k].min && fams[i]->keys[k].def <= fams[i]->keys[k].max,
                              "%s: default of '%s' out of its range", fams[i]->name, fams[i]->keys[k].name);
         }
-        SL_CHECK_MSG(has_seed, "%s has no seed key", fams[i]->name);
+        /* The ellipsoid has no randomness and no seed (its 8 keys are the SL_GEN_MAX_KEYS limit). */
+        SL_CHECK_MSG(has_seed != (fams[i] == &sl_gen_ellipsoid), "%s: seed key %s", fams[i]->name,
+                     has_seed ? "present, not expected" : "missing");
     }
     const sl_builtin_dataset *b = sl_builtin_datasets(&n);
     SL_CHECK(n >= 8);
@@ -1169,6 +1348,8 @@ static void test_fingerprints(void)
      {1728u, 1u, 0xd143def6ecbf59cbull, {{843.7492492251331, 1232.8549426402255, 857.36787907441612}, {0.54545454545454497, 2.0979020979020984, 6.545454545454545}, {0, 0, 0}, {0, 0, 0}}}},
     {"{\"generator\":\"head\",\"size\":12,\"noise\":0.5,\"seed\":3}",
      {1728u, 1u, 0x914e86e64053e0a9ull, {{436699, 636569.69230769132, 436699}, {60, 230.7692307692308, 720}, {0, 0, 0}, {0, 0, 0}}}},
+    {"{\"generator\":\"ellipsoid\",\"size\":12,\"a\":0.5,\"b\":0.4,\"c\":0.3,\"anisotropy\":1.5,\"voxel_type\":\"u16\"}",
+     {1152u, 1u, 0x665c9567ab8cc36dull, {{7077488, 9887651.5384615287, 7077488}, {0.63636363636363613, 2.2027972027972034, 6.545454545454545}, {0, 0, 0}, {0, 0, 0}}}},
     };
     static const char *const calls[] = {
         "{\"generator\":\"tornado\",\"lines\":12,\"points\":40,\"seed\":3}",
@@ -1180,6 +1361,7 @@ static void test_fingerprints(void)
         "{\"generator\":\"marschner_lobb\",\"size\":12,\"noise\":0.1,\"seed\":3}",
         "{\"generator\":\"torus\",\"size\":12,\"noise\":0.1,\"seed\":3}",
         "{\"generator\":\"head\",\"size\":12,\"noise\":0.5,\"seed\":3}",
+        "{\"generator\":\"ellipsoid\",\"size\":12,\"a\":0.5,\"b\":0.4,\"c\":0.3,\"anisotropy\":1.5,\"voxel_type\":\"u16\"}",
     };
     const char *print = getenv("SL_PRINT_FINGERPRINTS");
     size_t n_calls = sizeof calls / sizeof calls[0];
@@ -1237,6 +1419,7 @@ int main(void)
     test_tracer();
     test_hotroom();
     test_volumes();
+    test_ellipsoid();
     test_errors();
     test_catalog();
     test_info_tool();
