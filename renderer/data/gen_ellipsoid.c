@@ -95,7 +95,7 @@ const sl_gen_family sl_gen_ellipsoid = {
                    "f32 or u16/u8 = (f + 1.5) / 2.5 of the integer range, anisotropic z",
     .keys_help = "size voxels along x and y (8..512, default 64), a, b, c semi-axes as fractions of the half-extent "
                  "(0.05..0.95, default 0.6), anisotropy z spacing over x spacing (0.25..4, default 1), "
-                 "slices z slices (0..4096, default 0 = from anisotropy), voxel_type (\"f32\" default, \"u16\", \"u8\"), "
+                 "slices z slices (0..2048, default 0 = from anisotropy), voxel_type (\"f32\" default, \"u16\", \"u8\"), "
                  "profile (\"linear\" default, \"plateau\", \"sheet\")",
     .key_count = 8,
     .keys = {
@@ -104,7 +104,7 @@ const sl_gen_family sl_gen_ellipsoid = {
         {.name = "b", .type = SL_GEN_NUMBER, .min = 0.05, .max = 0.95, .def = 0.6},
         {.name = "c", .type = SL_GEN_NUMBER, .min = 0.05, .max = 0.95, .def = 0.6},
         {.name = "anisotropy", .type = SL_GEN_NUMBER, .min = 0.25, .max = 4, .def = 1},
-        {.name = "slices", .type = SL_GEN_INT, .min = 0, .max = 4096, .def = 0},
+        {.name = "slices", .type = SL_GEN_INT, .min = 0, .max = 2048, .def = 0},
         {.name = "voxel_type", .type = SL_GEN_CHOICE, .def = 0, .choices = {"f32", "u16", "u8"}},
         {.name = "profile", .type = SL_GEN_CHOICE, .def = 0, .choices = {"linear", "plateau", "sheet"}},
     },

@@ -1026,6 +1026,7 @@ static void test_errors(void)
     expect_error("{\"generator\":\"ellipsoid\",\"a\":0.01}", I, "'a'", "0.05..0.95");
     expect_error("{\"generator\":\"ellipsoid\",\"anisotropy\":5}", I, "'anisotropy'", "0.25..4");
     expect_error("{\"generator\":\"ellipsoid\",\"seed\":1}", I, "'seed'", "profile");
+    expect_error("{\"generator\":\"ellipsoid\",\"slices\":2049}", I, "'slices'", "0..2048");
     expect_error("{\"generator\":\"volcano\"}", I, "volcano", "tornado");
     expect_error("{\"generator\":7}", I, "'generator'", NULL);
     expect_error("{\"lines\":7}", I, "'generator'", NULL);
