@@ -11,6 +11,7 @@ extern const sl_technique sl_voxel_lines_technique;
 extern const sl_technique sl_lines_oit_technique;
 extern const sl_technique sl_volume_dvr_technique;
 extern const sl_technique sl_ribbons_technique;
+extern const sl_technique sl_particles_technique;
 
 static const sl_technique *const techniques[] = {
     &sl_tubes_mesh_technique,
@@ -19,6 +20,7 @@ static const sl_technique *const techniques[] = {
     &sl_lines_oit_technique,
     &sl_volume_dvr_technique,
     &sl_ribbons_technique,
+    &sl_particles_technique,
 };
 
 const sl_technique *const *sl_technique_list(int *count)

@@ -1,0 +1,443 @@
+/* particles.c — technique `particles`: illustrative isosurface particles
+ * (van Pelt, Vilanova, van de Wetering, "Illustrative Volume Visualization
+ * Using GPU-Based Particle Systems", IEEE TVCG 2010; README.md).
+ *
+ * prepare uploads the volume (exact values) and builds one particle set per
+ * isovalue (particles_system.h: placement, redistribution, curvature) —
+ * only the PREPARED parameters (isovalues, lattice spacing, repulsion
+ * radius, the stopping rule, sort, look-up, the particle cap) change the
+ * particles, so a camera move or a style change never recomputes them.
+ * render draws per set: hidden-surface removal by cone splatting into an id
+ * target (Algorithm 3), then the stipples that pass it. export writes every
+ * alive particle as CSV (set,x,y,z,nx,ny,nz,k1,k2,reliability, world units).
+ * Render thread only.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/sl_clock.h"
+#include "../core/sl_technique.h"
+#include "../data/sl_dataset.h"
+#include "../gpu/sl_gpu.h"
+#include "../volume/sl_volume.h"
+#include "particles_system.h"
+
+#define PT_MAX_SETS SL_PARAM_VALUES_MAX
+
+static const char *const sort_names[] = {"radix", "bitonic", NULL};
+static const char *const lookup_names[] = {"prefix_sum", "binary_search", NULL};
+
+static const sl_param_def particles_params[] = {
+    {"isovalues", SL_PARAM_VALUES, -1e30, 1e30, {0}, NULL, "data",
+     "one particle set per isovalue (up to 4; empty: one set at the end of the histogram's background peak, the "
+     "skin of a CT or MRI); each strictly inside the volume's value range", SL_INVALIDATE_PREPARED},
+    {"spacing", SL_PARAM_FLOAT, 0.25, 16.0, {1.25}, NULL, "voxel",
+     "lattice step of the feature location: a particle where the surface crosses a lattice edge (fewer particles "
+     "at a larger step, about 1.5 area / step^2)", SL_INVALIDATE_PREPARED},
+    {"repulsion_radius", SL_PARAM_FLOAT, 0.5, 8.0, {1.6}, NULL, "spacing",
+     "radius of the particles' repulsion, in lattice steps", SL_INVALIDATE_PREPARED},
+    {"energy_tol", SL_PARAM_FLOAT, 0.0, 1.0, {0.001}, NULL, "",
+     "stop the redistribution when the total energy changes by at most this share in a step (0: run max_steps)",
+     SL_INVALIDATE_PREPARED},
+    {"max_steps", SL_PARAM_INT, 0, 1000, {25}, NULL, "", "redistribution steps at most (the paper's 25)",
+     SL_INVALIDATE_PREPARED},
+    {"sort", SL_PARAM_ENUM, 0, 0, {0}, sort_names, "",
+     "GPU sort of the particles by bin: radix (stable, LSD) or bitonic (the paper's class)", SL_INVALIDATE_PREPARED},
+    {"lookup", SL_PARAM_ENUM, 0, 0, {0}, lookup_names, "",
+     "bin table: prefix sum of a histogram or a binary search per bin (the paper's); the same table",
+     SL_INVALIDATE_PREPARED},
+    {"max_particles", SL_PARAM_INT, 1000, 4000000, {1000000}, NULL, "",
+     "particles per set at most: a denser lattice is refused with the numbers", SL_INVALIDATE_PREPARED},
+    {"flat_curvature", SL_PARAM_FLOAT, 0.0, 1.0, {0.01}, NULL, "1/voxel",
+     "curvatures below this count as flat (reliability 0 in the export)", SL_INVALIDATE_FRAME},
+    {"hidden_surface_removal", SL_PARAM_INT, 0, 15, {15}, NULL, "sets",
+     "per set: draw only the particles whose cone wins their pixel (Algorithm 3), each set on its own",
+     SL_INVALIDATE_FRAME},
+    {"cone_radius", SL_PARAM_FLOAT, 0.3, 4.0, {1.0}, NULL, "nn",
+     "hidden-surface cones: radius in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
+    {"stipple", SL_PARAM_INT, 0, 15, {15}, NULL, "sets", "per set: draw stipples", SL_INVALIDATE_FRAME},
+    {"stipple_size", SL_PARAM_FLOAT, 0.0, 4.0, {0.6}, NULL, "nn",
+     "diameter of a full-tone stipple, in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
+    {"stipple_brightness", SL_PARAM_FLOAT, -1.0, 1.0, {0.0}, NULL, "", "shifts the tone: more is a brighter picture",
+     SL_INVALIDATE_FRAME},
+    {"stipple_contrast", SL_PARAM_FLOAT, 0.0, 8.0, {1.0}, NULL, "", "stretches the tone about its middle",
+     SL_INVALIDATE_FRAME},
+    {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
+    {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
+    {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
+    {"set3_color", SL_PARAM_VEC3, 0.0, 1.0, {0.7, 1.0, 0.6}, NULL, "rgb", "ink of set 3", SL_INVALIDATE_FRAME},
+    {"light_direction", SL_PARAM_VEC3, -1.0, 1.0, {0.3, 0.5, 1.0}, NULL, "eye space",
+     "direction towards the light: x right, y up, z towards the viewer", SL_INVALIDATE_FRAME},
+};
+
+typedef struct particles_state {
+    const sl_dataset *dataset;      /* borrowed */
+    sl_volume_geometry geom;
+    sl_volume_texture volume;
+    pt_system *system;
+    int set_count;
+    double iso[PT_MAX_SETS];
+    pt_set sets[PT_MAX_SETS];
+    GLuint cone_program, stipple_program, vao, camera_ubo;
+    GLuint id_fbo, id_tex, id_depth;   /* hidden-surface target, view sized */
+    int id_width, id_height;
+    float max_point;                   /* GL_POINT_SIZE_RANGE max */
+    size_t gpu_bytes;
+    sl_prepare_stats prep;
+} particles_state;
+
+static void release_id_target(particles_state *s)
+{
+    if (s->id_fbo) glDeleteFramebuffers(1, &s->id_fbo);
+    if (s->id_tex) glDeleteTextures(1, &s->id_tex);
+    if (s->id_depth) glDeleteTextures(1, &s->id_depth);
+    s->id_fbo = s->id_tex = s->id_depth = 0;
+    s->id_width = s->id_height = 0;
+}
+
+static void particles_release(void *opaque)
+{
+    particles_state *s = opaque;
+    if (!s)
+        return;
+    for (int k = 0; k < s->set_count; k++)
+        pt_set_release(&s->sets[k]);
+    pt_system_destroy(s->system);
+    sl_volume_texture_destroy(&s->volume);
+    release_id_target(s);
+    if (s->cone_program) glDeleteProgram(s->cone_program);
+    if (s->stipple_program) glDeleteProgram(s->stipple_program);
+    if (s->vao) glDeleteVertexArrays(1, &s->vao);
+    if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
+    free(s);
+}
+
+/* The isovalues of the sets: as given, or one at the end of the histogram's
+ * background peak (the start of the automatic opacity ramp), mid-range
+ * without one. Each must lie strictly inside the value range. */
+static sl_status resolve_isovalues(const sl_volume *vol, const sl_params *params, double iso[PT_MAX_SETS],
+                                   int *count, sl_err *err)
+{
+    int n = sl_params_values(params, "isovalues", iso);
+    double lo = vol->value_min, hi = vol->value_max;
+    if (n == 0) {
+        double ramp[4][2];
+        sl_volume_tf_auto_opacity(vol, ramp);
+        double t = ramp[0][0] > 0.0 && ramp[0][0] < 1.0 ? ramp[0][0] : 0.5;
+        iso[0] = lo + t * (hi - lo);
+        n = 1;
+    }
+    for (int k = 0; k < n; k++)
+        if (!(iso[k] > lo && iso[k] < hi))
+            return sl_err_set(err, SL_ERR_INVALID,
+                              "isovalue %g of set %d is at or beyond the volume's value range (%g, %g): no surface",
+                              iso[k], k, lo, hi);
+    *count = n;
+    return SL_OK;
+}
+
+static void add_extra(sl_prepare_stats *p, const char *name, double value)
+{
+    sl_prepare_stats_add(p, name, value);
+}
+
+static void fill_prepare_stats(particles_state *s)
+{
+    double placement = 0, sort = 0, lookup = 0, energy = 0, final = 0, preprocess = 0;
+    char name[32];
+    for (int k = 0; k < s->set_count; k++) {
+        const pt_set_stats *st = &s->sets[k].stats;
+        snprintf(name, sizeof name, "set%d.isovalue", k), add_extra(&s->prep, name, s->iso[k]);
+        snprintf(name, sizeof name, "set%d.particles", k), add_extra(&s->prep, name, st->alive);
+        snprintf(name, sizeof name, "set%d.seeded", k), add_extra(&s->prep, name, st->seeded);
+        snprintf(name, sizeof name, "set%d.dropped", k), add_extra(&s->prep, name, st->dropped);
+        snprintf(name, sizeof name, "set%d.steps", k), add_extra(&s->prep, name, st->steps);
+        snprintf(name, sizeof name, "set%d.final_energy", k), add_extra(&s->prep, name, st->final_energy);
+        snprintf(name, sizeof name, "set%d.ms_per_step", k), add_extra(&s->prep, name, st->ms_per_step);
+        snprintf(name, sizeof name, "set%d.mean_nn", k), add_extra(&s->prep, name, st->mean_nn);
+        snprintf(name, sizeof name, "set%d.nn_cv", k), add_extra(&s->prep, name, st->nn_cv);
+        placement += st->placement_ms;
+        sort += st->sort_ms + st->id_sort_ms + st->gather_ms;
+        lookup += st->lookup_ms;
+        energy += st->energy_ms;
+        final += st->final_ms + st->settle_ms;
+    }
+    preprocess = placement + sort + lookup + energy + final;
+    add_extra(&s->prep, "placement_ms", placement);
+    add_extra(&s->prep, "sort_ms", sort);
+    add_extra(&s->prep, "lookup_ms", lookup);
+    add_extra(&s->prep, "energy_ms", energy);
+    add_extra(&s->prep, "curvature_ms", final);
+    s->prep.preprocess_ms = preprocess;
+}
+
+static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
+                                   sl_err *err)
+{
+    (void)gpu;
+    *out = NULL;
+    particles_state *s = calloc(1, sizeof *s);
+    if (!s)
+        return sl_err_set(err, SL_ERR_NOMEM, "particles: out of memory");
+    s->dataset = ds;
+    sl_volume_geometry_init(ds, &s->geom);
+    sl_status st = resolve_isovalues(&ds->volume, params, s->iso, &s->set_count, err);
+    int built = 0;
+    if (st != SL_OK)
+        goto fail;
+    double t_upload = sl_clock_ms();
+    if ((st = sl_volume_texture_create(&ds->volume, &s->volume, err)) != SL_OK)
+        goto fail;
+    glFinish();
+    s->prep.upload_ms = sl_clock_ms() - t_upload;
+    if ((st = pt_system_create(&s->system, err)) != SL_OK ||
+        (st = sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_cone.vert.glsl",
+                                                      .fragment = "particles/particles_cone.frag.glsl",
+                                                      .label = "particles cones"},
+                                   &s->cone_program, err)) != SL_OK ||
+        (st = sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_marks.vert.glsl",
+                                                      .fragment = "particles/particles_marks.frag.glsl",
+                                                      .label = "particles stipples"},
+                                   &s->stipple_program, err)) != SL_OK)
+        goto fail;
+    pt_field field = {.texture = s->volume.tex,
+                      .value_scale = s->volume.value_scale,
+                      .value_offset = s->volume.value_offset,
+                      .min_spacing = s->geom.min_spacing,
+                      .value_min = ds->volume.value_min,
+                      .value_max = ds->volume.value_max};
+    for (int a = 0; a < 3; a++) {
+        field.dims[a] = ds->volume.dims[a];
+        field.spacing[a] = ds->volume.spacing[a];
+    }
+    double step = sl_params_float(params, "spacing");
+    pt_system_desc desc = {.lattice_step = step,
+                           .sigma = sl_params_float(params, "repulsion_radius") * step * s->geom.min_spacing,
+                           .energy_tol = sl_params_float(params, "energy_tol"),
+                           .max_steps = sl_params_int(params, "max_steps"),
+                           .sort = (pt_sort_method)sl_params_choice(params, "sort"),
+                           .lookup = (pt_lookup_method)sl_params_choice(params, "lookup"),
+                           .max_particles = (uint32_t)sl_params_int(params, "max_particles")};
+    for (built = 0; built < s->set_count; built++) {
+        desc.iso = s->iso[built];
+        if ((st = pt_set_build(s->system, &field, &desc, &s->sets[built], err)) != SL_OK) {
+            sl_err_prefix(err, "set %d (isovalue %g)", built, s->iso[built]);
+            goto fail;
+        }
+        s->gpu_bytes += s->sets[built].bytes;
+    }
+    glCreateVertexArrays(1, &s->vao);
+    GLfloat range[2] = {1, 64};
+    glGetFloatv(GL_POINT_SIZE_RANGE, range);
+    s->max_point = range[1];
+    if ((st = sl_gl_check_errors("particles: preparing", err)) != SL_OK)
+        goto fail;
+    s->gpu_bytes += s->volume.bytes;
+    fill_prepare_stats(s);
+    *out = s;
+    return SL_OK;
+fail:
+    s->set_count = built;
+    sl_err_prefix(err, "particles");
+    particles_release(s);
+    return st;
+}
+
+/* The view-sized id + depth target of the hidden-surface pass. */
+static sl_status ensure_id_target(particles_state *s, int w, int h, sl_err *err)
+{
+    if (s->id_fbo && s->id_width == w && s->id_height == h)
+        return SL_OK;
+    release_id_target(s);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->id_tex);
+    glTextureStorage2D(s->id_tex, 1, GL_R32UI, w, h);
+    /* An integer texture is complete only with NEAREST filters. */
+    glTextureParameteri(s->id_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(s->id_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->id_depth);
+    glTextureStorage2D(s->id_depth, 1, GL_DEPTH_COMPONENT32F, w, h);
+    glCreateFramebuffers(1, &s->id_fbo);
+    glNamedFramebufferTexture(s->id_fbo, GL_COLOR_ATTACHMENT0, s->id_tex, 0);
+    glNamedFramebufferTexture(s->id_fbo, GL_DEPTH_ATTACHMENT, s->id_depth, 0);
+    if (glCheckNamedFramebufferStatus(s->id_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        release_id_target(s);
+        return sl_err_set(err, SL_ERR_GPU, "particles: the hidden-surface target (%dx%d) is incomplete", w, h);
+    }
+    s->id_width = w;
+    s->id_height = h;
+    return sl_gl_check_errors("particles: the hidden-surface target", err);
+}
+
+static double luminance(const float c[3])
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
+static void set_frame_uniforms(GLuint p, const particles_state *s, const sl_view *view)
+{
+    glUniform3f(glGetUniformLocation(p, "u_volume_offset"), (float)(s->geom.origin.x - view->origin.x),
+                (float)(s->geom.origin.y - view->origin.y), (float)(s->geom.origin.z - view->origin.z));
+    glUniform1f(glGetUniformLocation(p, "u_px_per_world"), (float)(view->height / (2.0 * view->tan_half_fov)));
+    glUniform1f(glGetUniformLocation(p, "u_max_point"), s->max_point);
+}
+
+static sl_status particles_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
+                                  sl_render_stats *stats, sl_err *err)
+{
+    particles_state *s = opaque;
+    int hsr_mask = sl_params_int(params, "hidden_surface_removal");
+    int stipple_mask = sl_params_int(params, "stipple");
+    sl_camera_ubo_update(&s->camera_ubo, view);
+    float l[3];
+    sl_params_vec3(params, "light_direction", l);
+    double ll = sqrt((double)l[0] * l[0] + (double)l[1] * l[1] + (double)l[2] * l[2]);
+    double le[3] = {0.0, 0.0, 1.0};
+    if (ll > 0.0)
+        for (int c = 0; c < 3; c++)
+            le[c] = l[c] / ll;
+    sl_vec3 lw = sl_v3_add(sl_v3_add(sl_v3_scale(view->right, le[0]), sl_v3_scale(view->upv, le[1])),
+                           sl_v3_scale(view->forward, -le[2]));
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glPointParameteri(GL_POINT_SPRITE_COORD_ORIGIN, GL_LOWER_LEFT);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(s->vao);
+    double drawn = 0.0;
+    for (int k = 0; k < s->set_count; k++) {
+        const pt_set *set = &s->sets[k];
+        GLsizei n = (GLsizei)set->stats.alive;
+        if (n == 0 || !(stipple_mask >> k & 1))
+            continue;
+        double cone_radius = sl_params_float(params, "cone_radius") * set->stats.mean_nn;
+        int hsr = hsr_mask >> k & 1 && cone_radius > 0.0;
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, set->records);
+        if (hsr) {
+            sl_status st = ensure_id_target(s, view->width, view->height, err);
+            if (st != SL_OK)
+                return st;
+            glBindFramebuffer(GL_FRAMEBUFFER, s->id_fbo);
+            glViewport(0, 0, view->width, view->height);
+            const GLuint zero[4] = {0, 0, 0, 0};
+            const GLfloat far_depth = 0.0f;
+            glClearNamedFramebufferuiv(s->id_fbo, GL_COLOR, 0, zero);
+            glClearNamedFramebufferfv(s->id_fbo, GL_DEPTH, 0, &far_depth);
+            glEnable(GL_DEPTH_TEST);
+            glDepthFunc(GL_GREATER);
+            glDepthMask(GL_TRUE);
+            glDisable(GL_BLEND);
+            glUseProgram(s->cone_program);
+            set_frame_uniforms(s->cone_program, s, view);
+            glUniform1f(glGetUniformLocation(s->cone_program, "u_cone_radius"), (float)cone_radius);
+            glDrawArrays(GL_POINTS, 0, n);
+            glBindFramebuffer(GL_FRAMEBUFFER, target->fbo);
+            glViewport(0, 0, target->width, target->height);
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+        }
+        char name[16];
+        float ink[3];
+        snprintf(name, sizeof name, "set%d_color", k);
+        sl_params_vec3(params, name, ink);
+        GLuint p = s->stipple_program;
+        glUseProgram(p);
+        set_frame_uniforms(p, s, view);
+        glUniform1i(glGetUniformLocation(p, "u_ids"), 0);
+        glBindTextureUnit(0, hsr ? s->id_tex : 0);
+        glUniform1i(glGetUniformLocation(p, "u_hsr"), hsr);
+        glUniform3f(glGetUniformLocation(p, "u_light_world"), (float)lw.x, (float)lw.y, (float)lw.z);
+        glUniform1f(glGetUniformLocation(p, "u_mean_spacing"), (float)set->stats.mean_nn);
+        glUniform1f(glGetUniformLocation(p, "u_stipple_size"), (float)sl_params_float(params, "stipple_size"));
+        glUniform1f(glGetUniformLocation(p, "u_brightness"), (float)sl_params_float(params, "stipple_brightness"));
+        glUniform1f(glGetUniformLocation(p, "u_contrast"), (float)sl_params_float(params, "stipple_contrast"));
+        glUniform1i(glGetUniformLocation(p, "u_ink_dark"), luminance(ink) < luminance(view->background));
+        glUniform3f(glGetUniformLocation(p, "u_ink"), ink[0], ink[1], ink[2]);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_TRUE);
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glDrawArrays(GL_POINTS, 0, n);
+        drawn += n;
+    }
+    glDisable(GL_BLEND);
+    glBindTextureUnit(0, 0);
+    glBindVertexArray(0);
+    glDisable(GL_PROGRAM_POINT_SIZE);
+    stats->primitives = drawn;
+    for (int k = 0; k < s->set_count; k++)
+        stats->dropped += s->sets[k].stats.dropped;
+    return SL_OK;
+}
+
+static size_t particles_gpu_bytes(const void *opaque)
+{
+    const particles_state *s = opaque;
+    if (!s)
+        return 0;
+    return s->gpu_bytes + (size_t)s->id_width * s->id_height * 8;
+}
+
+static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)
+{
+    const particles_state *s = opaque;
+    *out = s ? s->prep : (sl_prepare_stats){0};
+}
+
+/* The reliability of the principal directions (README.md; sec. 4.2.3). */
+static double reliability(double k1, double k2, double eps)
+{
+    if (fabs(k1) < eps && fabs(k2) < eps)
+        return 0.0;
+    double si;
+    if (k1 == k2)
+        si = k1 > 0 ? -1.0 : 1.0;
+    else
+        si = 2.0 / M_PI * atan((k2 + k1) / (k2 - k1));
+    return 1.0 - fabs(2.0 * (fabs(si) - 0.5));
+}
+
+static sl_status particles_export(void *opaque, const sl_params *params, const char *path, sl_err *err)
+{
+    const particles_state *s = opaque;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return sl_err_set(err, SL_ERR_IO, "particles: cannot write %s", path);
+    double eps = sl_params_float(params, "flat_curvature") / s->geom.min_spacing;
+    fprintf(f, "set,x,y,z,nx,ny,nz,k1,k2,reliability\n");
+    sl_status st = SL_OK;
+    for (int k = 0; k < s->set_count && st == SL_OK; k++) {
+        uint32_t n = s->sets[k].stats.alive;
+        if (n == 0)
+            continue;
+        pt_record *r = malloc((size_t)n * sizeof *r);
+        if (!r) {
+            st = sl_err_set(err, SL_ERR_NOMEM, "particles: out of memory exporting %u particles", n);
+            break;
+        }
+        glGetNamedBufferSubData(s->sets[k].records, 0, (GLsizeiptr)((size_t)n * sizeof *r), r);
+        for (uint32_t i = 0; i < n; i++)
+            fprintf(f, "%d,%.9g,%.9g,%.9g,%.7g,%.7g,%.7g,%.7g,%.7g,%.6g\n", k, s->geom.origin.x + r[i].x[0],
+                    s->geom.origin.y + r[i].x[1], s->geom.origin.z + r[i].x[2], r[i].n[0], r[i].n[1], r[i].n[2],
+                    r[i].k1, r[i].k2, reliability(r[i].k1, r[i].k2, eps));
+        free(r);
+    }
+    if (fclose(f) != 0 && st == SL_OK)
+        st = sl_err_set(err, SL_ERR_IO, "particles: writing %s failed", path);
+    return st;
+}
+
+const sl_technique sl_particles_technique = {
+    .name = "particles",
+    .description = "illustrative isosurface particles: stippling with hidden-surface removal "
+                   "(van Pelt et al., GPU-based particle systems, 2010)",
+    .dataset_kinds = SL_DATASET_VOLUME,
+    .params = particles_params,
+    .param_count = (int)(sizeof particles_params / sizeof particles_params[0]),
+    .prepare = particles_prepare,
+    .render = particles_render,
+    .release = particles_release,
+    .gpu_bytes = particles_gpu_bytes,
+    .prepare_stats = particles_prepare_stats,
+    .export_ext = ".csv",
+    .export_geometry = particles_export,
+};
