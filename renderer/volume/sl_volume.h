@@ -188,9 +188,9 @@ typedef struct sl_volume_march_focus {
     double centre[3];         /* world */
     double radius;            /* world; 0 = no focus (the plain path) */
     GLuint opaque_depth_tex;  /* borrowed: a 2D depth (or R32F) texture of the
-                                 view's size, reversed-Z, 0 = nothing drawn; must
-                                 not be attached to the bound framebuffer. 0 as a
-                                 name: no marks at all */
+                                 view's size, the marks' reversed-Z depth (texel
+                                 0: no mark there); not attached to the bound
+                                 framebuffer. Name 0: no marks at all */
 } sl_volume_march_focus;
 
 /* Everything one draw decides; zero-initialized = the defaults noted. */
@@ -244,7 +244,9 @@ void sl_volume_marcher_deinit(sl_volume_marcher *m); /* zeroed or failed init is
  * opaque depth), the SSBO at binding 5, the camera UBO at binding 0, VAO 0,
  * depth test on with GL_GREATER, depth writes on, blending off, culling off.
  * stats: primitives (pixels), samples taken and skipped, culled (bricks not
- * visible). SL_ERR_GPU when a variant fails to compile (the log in err). */
+ * visible). SL_ERR_INVALID for a mode out of range, no tf, a negative or
+ * NaN step or focus radius (nothing drawn); SL_ERR_GPU when a variant fails
+ * to compile (the log in err). */
 sl_status sl_volume_marcher_draw(sl_volume_marcher *m, const sl_volume_texture *vol, sl_volume_bricks *b,
                                  const sl_volume_geometry *g, const sl_view *view, const sl_volume_march_desc *d,
                                  sl_render_stats *stats, sl_err *err);

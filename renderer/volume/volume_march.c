@@ -163,6 +163,10 @@ sl_status sl_volume_marcher_draw(sl_volume_marcher *m, const sl_volume_texture *
                                  const sl_volume_geometry *g, const sl_view *view, const sl_volume_march_desc *d,
                                  sl_render_stats *stats, sl_err *err)
 {
+    if ((unsigned)d->mode > SL_VOLUME_MARCH_ISO || !d->tf || !(d->step >= 0.0) || !(d->focus.radius >= 0.0))
+        return sl_err_set(err, SL_ERR_INVALID,
+                          "volume marcher: bad descriptor (mode %d, tf %s, step %g, focus radius %g)", (int)d->mode,
+                          d->tf ? "set" : "missing", d->step, d->focus.radius);
     update_tf_and_mask(m, b, d);
     int iso = d->mode == SL_VOLUME_MARCH_ISO;
     int shading = (d->shading && d->mode == SL_VOLUME_MARCH_COMPOSITE) || iso;

@@ -249,8 +249,9 @@ static void check_opaque_plane(fixture *f)
         }
     }
     double right_mean = right_covered ? right_sum / (3.0 * right_covered) : 0.0;
-    printf("opaque plane: %d left pixels changed (%d covered without the plane); right: %d covered, mean |dRGB| %.4f against the plain path, "
-           "%d depths differ\n", left_changed, left_covered, right_covered, right_mean, right_mismatch);
+    printf("opaque plane: %d left pixels changed (%d covered without the plane); right: %d covered, "
+           "mean |dRGB| %.4f against the plain path, %d depths differ\n",
+           left_changed, left_covered, right_covered, right_mean, right_mismatch);
     SL_CHECK(left_covered > N / 20 && left_unmarked == 0);
     SL_CHECK_MSG(left_changed == 0, "%d pixels behind the opaque plane's depth changed", left_changed);
     SL_CHECK(right_covered > N / 20);
