@@ -7,11 +7,13 @@
  * brick grid with a per-transfer-function "visible bricks" mask and its
  * runs (distance maps: how far a ray may go without a brick lookup). GLSL halves:
  * volume/volume_ray.glsl (ray–box + clip box), volume/volume_sample.glsl
- * (values), volume/volume_tf.glsl (lookup + opacity correction).
+ * (values), volume/volume_tf.glsl (lookup + opacity correction). And the one
+ * ray marcher both volume_dvr and particles draw with (sl_volume_marcher,
+ * volume_march.c, volume/volume_march.glsl + volume_march.frag.glsl).
  * Invariants: the min-max grid is built once per volume; a new transfer
  * function re-bakes the TF texture and rebuilds the mask from that grid only
  * (counted in sl_volume_counters). Vector fields are drawn by magnitude.
- * Not here: ray marching, shading, techniques' parameters. GL functions run
+ * Not here: techniques' parameters (the marcher takes a descriptor). GL functions run
  * on the render thread; the CPU functions (resolve, bake, mask) on any.
  */
 #ifndef SL_VOLUME_H
@@ -22,7 +24,9 @@
 
 #include <epoxy/gl.h>
 
+#include "../core/sl_camera.h"
 #include "../core/sl_params.h"
+#include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 
 /* Geometry: voxel (i,j,k) sits at origin + spacing·(i,j,k); the box spans
@@ -159,6 +163,93 @@ size_t sl_volume_bricks_update_mask(sl_volume_bricks *b, sl_volume_mask_rule rul
 #define SL_VOLUME_RUN_MAX 127
 #define SL_VOLUME_RUN_VISIBLE 128
 int sl_volume_brick_runs(const uint8_t *visible, const int dims[3], uint8_t *out);
+
+/* The ray marcher (volume_march.c; volume_march.frag.glsl over volume_march.glsl):
+ * one full-screen pass, a ray per pixel, the model of volume_dvr/README.md.
+ * The marcher owns what marching needs besides the volume's own preparation:
+ * its programs (one per variant, compiled on first use), the TF texture with
+ * its baked table and the transfer function it was baked from (re-baked only
+ * when the desc's one differs), the brick mask's state (rebuilt only when the
+ * rule, TF or isovalue changes), the per-row sample counters, a camera UBO
+ * and an empty VAO. It borrows the volume it was made for (resolves transfer
+ * functions against its value range and histogram). Render thread only. */
+typedef enum sl_volume_march_mode {
+    SL_VOLUME_MARCH_COMPOSITE = 0, /* emission-absorption, front to back */
+    SL_VOLUME_MARCH_MIP,           /* maximum intensity, then the TF */
+    SL_VOLUME_MARCH_ISO,           /* first crossing of iso, shaded */
+} sl_volume_march_mode;
+
+/* Focus + context (docs/particles_plan.md §1.11): radius > 0 selects the
+ * SL_FOCUS 1 program. The ray interval is clipped to the sphere and ended at
+ * the opaque marks' depth; the output is premultiplied (C, A), blended
+ * (ONE, ONE_MINUS_SRC_ALPHA) over the target, and the depth written is the
+ * larger (nearer, reversed-Z) of the mark's and the marcher's (A > 0.5). */
+typedef struct sl_volume_march_focus {
+    double centre[3];         /* world */
+    double radius;            /* world; 0 = no focus (the plain path) */
+    GLuint opaque_depth_tex;  /* borrowed: a 2D depth (or R32F) texture of the
+                                 view's size, the marks' reversed-Z depth (texel
+                                 0: no mark there); not attached to the bound
+                                 framebuffer. Name 0: no marks at all */
+} sl_volume_march_focus;
+
+/* Everything one draw decides; zero-initialized = the defaults noted. */
+typedef struct sl_volume_march_desc {
+    sl_volume_march_mode mode;
+    const sl_transfer_function *tf; /* borrowed; required */
+    double step;              /* in units of min_spacing; 0 = 0.5. Doubled (at most 16) on
+                                 interactive views */
+    double iso;               /* ISO: the surface's value */
+    double alpha_stop;        /* COMPOSITE: stop at this opacity; 0 = 0.99 */
+    int jitter;               /* 1: per-pixel random start within a step; 0: midpoints */
+    int no_skipping;          /* 1: sample every brick (same image, for checks) */
+    int nearest;              /* 1: nearest voxel; 0: trilinear */
+    int shading;              /* COMPOSITE: Blinn-Phong with the gradient (ISO always shades) */
+    GLuint gradient_tex;      /* borrowed; when shading: normals from it (sl_volume_gradient_create);
+                                 0 = central differences per sample */
+    int clip;                 /* 1: clip to [clip_min, clip_max] (0..1 of the box) */
+    double clip_min[3], clip_max[3];
+    double light_dir[3];      /* eye space (x right, y up, z to the viewer), towards the
+                                 light, any length; zero = (0, 0, 1) */
+    double material[4];       /* ambient, diffuse, specular, shininess; all zero =
+                                 0.25, 0.75, 0.3, 32 */
+    sl_volume_march_focus focus;
+} sl_volume_march_desc;
+
+#define SL_VOLUME_MARCH_VARIANTS 24 /* mode x shading x gradient source x focus */
+typedef struct sl_volume_marcher {
+    const sl_volume *data;    /* borrowed */
+    GLuint programs[SL_VOLUME_MARCH_VARIANTS]; /* 0 until first used */
+    GLuint vao, camera_ubo, tf_tex, rows_buf;
+    int rows_capacity;        /* pixel rows rows_buf holds */
+    sl_volume_tf_table *table; /* owned; baked from tf_loaded */
+    sl_transfer_function tf_loaded;
+    int tf_valid;
+    int mask_rule;            /* sl_volume_mask_rule of the bricks' mask, or -1 */
+    double mask_iso;
+    size_t visible_bricks;
+    size_t bytes;             /* GPU bytes held: the TF texture */
+} sl_volume_marcher;
+
+/* Compiles the plain composite program, creates the TF texture and the VAO.
+ * data: borrowed, must outlive m. SL_ERR_NOMEM, SL_ERR_GPU (a compile or
+ * link log included); on failure *m holds nothing (deinit is still safe). */
+sl_status sl_volume_marcher_init(sl_volume_marcher *m, const sl_volume *data, sl_err *err);
+void sl_volume_marcher_deinit(sl_volume_marcher *m); /* zeroed or failed init is fine */
+
+/* One pass into the bound framebuffer (viewport = view's size). vol, b and g
+ * come from m's volume; b's mask is rebuilt when the mode's rule, the TF or
+ * the isovalue changed. Sets every state it relies on and leaves: its program,
+ * texture units 0-4 (volume, TF, runs, min-max, gradient) and 6 (focus:
+ * opaque depth), the SSBO at binding 5, the camera UBO at binding 0, VAO 0,
+ * depth test on with GL_GREATER, depth writes on, blending off, culling off.
+ * stats: primitives (pixels), samples taken and skipped, culled (bricks not
+ * visible). SL_ERR_INVALID for a mode out of range, no tf, a negative or
+ * NaN step or focus radius (nothing drawn); SL_ERR_GPU when a variant fails
+ * to compile (the log in err). */
+sl_status sl_volume_marcher_draw(sl_volume_marcher *m, const sl_volume_texture *vol, sl_volume_bricks *b,
+                                 const sl_volume_geometry *g, const sl_view *view, const sl_volume_march_desc *d,
+                                 sl_render_stats *stats, sl_err *err);
 
 /* Work counters: process-wide totals, never reset (compare two readings).
  * Render thread only, unlocked. */
