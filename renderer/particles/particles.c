@@ -22,6 +22,9 @@
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
 #include "../volume/sl_volume.h"
+#include "particles_frame.h"
+#include "particles_hsr.h"
+#include "particles_stipple.h"
 #include "particles_system.h"
 
 #define PT_MAX_SETS SL_PARAM_VALUES_MAX
@@ -80,22 +83,13 @@ typedef struct particles_state {
     int set_count;
     double iso[PT_MAX_SETS];
     pt_set sets[PT_MAX_SETS];
-    GLuint cone_program, stipple_program, vao, camera_ubo;
-    GLuint id_fbo, id_tex, id_depth;   /* hidden-surface target, view sized */
-    int id_width, id_height;
+    pt_hsr hsr;
+    pt_stipple stipple;
+    GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
     sl_prepare_stats prep;
 } particles_state;
-
-static void release_id_target(particles_state *s)
-{
-    if (s->id_fbo) glDeleteFramebuffers(1, &s->id_fbo);
-    if (s->id_tex) glDeleteTextures(1, &s->id_tex);
-    if (s->id_depth) glDeleteTextures(1, &s->id_depth);
-    s->id_fbo = s->id_tex = s->id_depth = 0;
-    s->id_width = s->id_height = 0;
-}
 
 static void particles_release(void *opaque)
 {
@@ -106,9 +100,8 @@ static void particles_release(void *opaque)
         pt_set_release(&s->sets[k]);
     pt_system_destroy(s->system);
     sl_volume_texture_destroy(&s->volume);
-    release_id_target(s);
-    if (s->cone_program) glDeleteProgram(s->cone_program);
-    if (s->stipple_program) glDeleteProgram(s->stipple_program);
+    pt_hsr_deinit(&s->hsr);
+    pt_stipple_deinit(&s->stipple);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -192,15 +185,8 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         goto fail;
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
-    if ((st = pt_system_create(&s->system, err)) != SL_OK ||
-        (st = sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_cone.vert.glsl",
-                                                      .fragment = "particles/particles_cone.frag.glsl",
-                                                      .label = "particles cones"},
-                                   &s->cone_program, err)) != SL_OK ||
-        (st = sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_marks.vert.glsl",
-                                                      .fragment = "particles/particles_marks.frag.glsl",
-                                                      .label = "particles stipples"},
-                                   &s->stipple_program, err)) != SL_OK)
+    if ((st = pt_system_create(&s->system, err)) != SL_OK || (st = pt_hsr_init(&s->hsr, err)) != SL_OK ||
+        (st = pt_stipple_init(&s->stipple, err)) != SL_OK)
         goto fail;
     pt_field field = {.texture = s->volume.tex,
                       .value_scale = s->volume.value_scale,
@@ -245,42 +231,9 @@ fail:
     return st;
 }
 
-/* The view-sized id + depth target of the hidden-surface pass. */
-static sl_status ensure_id_target(particles_state *s, int w, int h, sl_err *err)
-{
-    if (s->id_fbo && s->id_width == w && s->id_height == h)
-        return SL_OK;
-    release_id_target(s);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->id_tex);
-    glTextureStorage2D(s->id_tex, 1, GL_R32UI, w, h);
-    /* An integer texture is complete only with NEAREST filters. */
-    glTextureParameteri(s->id_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(s->id_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->id_depth);
-    glTextureStorage2D(s->id_depth, 1, GL_DEPTH_COMPONENT32F, w, h);
-    glCreateFramebuffers(1, &s->id_fbo);
-    glNamedFramebufferTexture(s->id_fbo, GL_COLOR_ATTACHMENT0, s->id_tex, 0);
-    glNamedFramebufferTexture(s->id_fbo, GL_DEPTH_ATTACHMENT, s->id_depth, 0);
-    if (glCheckNamedFramebufferStatus(s->id_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        release_id_target(s);
-        return sl_err_set(err, SL_ERR_GPU, "particles: the hidden-surface target (%dx%d) is incomplete", w, h);
-    }
-    s->id_width = w;
-    s->id_height = h;
-    return sl_gl_check_errors("particles: the hidden-surface target", err);
-}
-
 static double luminance(const float c[3])
 {
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-}
-
-static void set_frame_uniforms(GLuint p, const particles_state *s, const sl_view *view)
-{
-    glUniform3f(glGetUniformLocation(p, "u_volume_offset"), (float)(s->geom.origin.x - view->origin.x),
-                (float)(s->geom.origin.y - view->origin.y), (float)(s->geom.origin.z - view->origin.z));
-    glUniform1f(glGetUniformLocation(p, "u_px_per_world"), (float)(view->height / (2.0 * view->tan_half_fov)));
-    glUniform1f(glGetUniformLocation(p, "u_max_point"), s->max_point);
 }
 
 static sl_status particles_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
@@ -290,15 +243,8 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
     int hsr_mask = sl_params_int(params, "hidden_surface_removal");
     int stipple_mask = sl_params_int(params, "stipple");
     sl_camera_ubo_update(&s->camera_ubo, view);
-    float l[3];
-    sl_params_vec3(params, "light_direction", l);
-    double ll = sqrt((double)l[0] * l[0] + (double)l[1] * l[1] + (double)l[2] * l[2]);
-    double le[3] = {0.0, 0.0, 1.0};
-    if (ll > 0.0)
-        for (int c = 0; c < 3; c++)
-            le[c] = l[c] / ll;
-    sl_vec3 lw = sl_v3_add(sl_v3_add(sl_v3_scale(view->right, le[0]), sl_v3_scale(view->upv, le[1])),
-                           sl_v3_scale(view->forward, -le[2]));
+    pt_frame frame;
+    pt_frame_init(&frame, view, params, s->geom.origin, s->max_point);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glPointParameteri(GL_POINT_SPRITE_COORD_ORIGIN, GL_LOWER_LEFT);
     glDisable(GL_CULL_FACE);
@@ -306,58 +252,27 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
     double drawn = 0.0;
     for (int k = 0; k < s->set_count; k++) {
         const pt_set *set = &s->sets[k];
-        GLsizei n = (GLsizei)set->stats.alive;
-        if (n == 0 || !(stipple_mask >> k & 1))
+        int styles = stipple_mask;
+        if (set->stats.alive == 0 || !(styles >> k & 1))
             continue;
-        double cone_radius = sl_params_float(params, "cone_radius") * set->stats.mean_nn;
-        int hsr = hsr_mask >> k & 1 && cone_radius > 0.0;
+        pt_set_view sv = {.set = set, .index = k};
+        char name[16];
+        snprintf(name, sizeof name, "set%d_color", k);
+        sl_params_vec3(params, name, sv.ink);
+        sv.ink_dark = luminance(sv.ink) < luminance(view->background);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, set->records);
-        if (hsr) {
-            sl_status st = ensure_id_target(s, view->width, view->height, err);
+        double cone_radius = sl_params_float(params, "cone_radius") * set->stats.mean_nn;
+        if (hsr_mask >> k & 1 && cone_radius > 0.0) {
+            sl_status st = pt_hsr_draw(&s->hsr, &frame, (GLsizei)set->stats.alive, cone_radius, err);
             if (st != SL_OK)
                 return st;
-            glBindFramebuffer(GL_FRAMEBUFFER, s->id_fbo);
-            glViewport(0, 0, view->width, view->height);
-            const GLuint zero[4] = {0, 0, 0, 0};
-            const GLfloat far_depth = 0.0f;
-            glClearNamedFramebufferuiv(s->id_fbo, GL_COLOR, 0, zero);
-            glClearNamedFramebufferfv(s->id_fbo, GL_DEPTH, 0, &far_depth);
-            glEnable(GL_DEPTH_TEST);
-            glDepthFunc(GL_GREATER);
-            glDepthMask(GL_TRUE);
-            glDisable(GL_BLEND);
-            glUseProgram(s->cone_program);
-            set_frame_uniforms(s->cone_program, s, view);
-            glUniform1f(glGetUniformLocation(s->cone_program, "u_cone_radius"), (float)cone_radius);
-            glDrawArrays(GL_POINTS, 0, n);
             glBindFramebuffer(GL_FRAMEBUFFER, target->fbo);
             glViewport(0, 0, target->width, target->height);
-            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+            sv.hsr = 1;
+            sv.id_tex = s->hsr.ids;
         }
-        char name[16];
-        float ink[3];
-        snprintf(name, sizeof name, "set%d_color", k);
-        sl_params_vec3(params, name, ink);
-        GLuint p = s->stipple_program;
-        glUseProgram(p);
-        set_frame_uniforms(p, s, view);
-        glUniform1i(glGetUniformLocation(p, "u_ids"), 0);
-        glBindTextureUnit(0, hsr ? s->id_tex : 0);
-        glUniform1i(glGetUniformLocation(p, "u_hsr"), hsr);
-        glUniform3f(glGetUniformLocation(p, "u_light_world"), (float)lw.x, (float)lw.y, (float)lw.z);
-        glUniform1f(glGetUniformLocation(p, "u_mean_spacing"), (float)set->stats.mean_nn);
-        glUniform1f(glGetUniformLocation(p, "u_stipple_size"), (float)sl_params_float(params, "stipple_size"));
-        glUniform1f(glGetUniformLocation(p, "u_brightness"), (float)sl_params_float(params, "stipple_brightness"));
-        glUniform1f(glGetUniformLocation(p, "u_contrast"), (float)sl_params_float(params, "stipple_contrast"));
-        glUniform1i(glGetUniformLocation(p, "u_ink_dark"), luminance(ink) < luminance(view->background));
-        glUniform3f(glGetUniformLocation(p, "u_ink"), ink[0], ink[1], ink[2]);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_GREATER);
-        glDepthMask(GL_TRUE);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glDrawArrays(GL_POINTS, 0, n);
-        drawn += n;
+        if (stipple_mask >> k & 1)
+            drawn += pt_stipple_draw(&s->stipple, &frame, &sv, params);
     }
     glDisable(GL_BLEND);
     glBindTextureUnit(0, 0);
@@ -374,7 +289,7 @@ static size_t particles_gpu_bytes(const void *opaque)
     const particles_state *s = opaque;
     if (!s)
         return 0;
-    return s->gpu_bytes + (size_t)s->id_width * s->id_height * 8;
+    return s->gpu_bytes + pt_hsr_bytes(&s->hsr);
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)
