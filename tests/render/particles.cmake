@@ -244,3 +244,13 @@ pt_test(goldens ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-regress>|${PT_DIR}/goldens|--out|${PT_OUT}/goldens|--jobs|2"
   "-DOUT1=3 cases, 3 passed, 0 failed, 0 errors"
   ${SL_STEPS})
+
+# ---- the field functions on the GPU (particles_field.glsl through the probe
+# particles_probe.comp.glsl) against the double-precision references:
+# trilinear and B-spline values, gradients, Hessians and the curvature.
+add_executable(test_particles_probe ${PT_DIR}/test_particles_probe.c)
+target_link_libraries(test_particles_probe PRIVATE sightline_test_support sightline_renderer)
+set_target_properties(test_particles_probe PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+add_test(NAME unit.test_particles_probe COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_particles_probe>
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(unit.test_particles_probe PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
