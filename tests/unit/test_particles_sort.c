@@ -2,7 +2,7 @@
  * against CPU references written here, and the shared GPU scan (gpu/sl_gpu_scan.h) they build on.
  *
  * Sorts: n in {0, 1, 2, 255, 256, 257, 1023, 1025, 65535, 65537, 200000},
- * keys random in [0, 2^b) for b in {1, 8, 23} and all equal, values 0..n-1:
+ * keys random in [0, 2^b) for b in {1, 8, 20, 23, 32} and all equal, values 0..n-1:
  * radix and bitonic must both equal the CPU stable sort word for word (so
  * radix is stable and bitonic orders by (key, value)). Tables: keys with
  * ~1/8 sentinels >= bins, GPU-sorted, for bins in {1, 1000, 2^20}: both
@@ -109,7 +109,8 @@ static void check_sort(pt_sorter *sorter, pt_sort_method m, const uint32_t *keys
 
 static void test_sorts(pt_sorter *sorter, const uint32_t *sizes, int size_count)
 {
-    static const uint32_t bit_cases[] = {1, 8, 23, 0}; /* 0: all keys equal */
+    /* Key bits (radix passes: 1, 2, 5 and 6, 8; odd counts end with the copy back); 0: all keys equal. */
+    static const uint32_t bit_cases[] = {1, 8, 20, 23, 32, 0};
     for (int si = 0; si < size_count; si++) {
         uint32_t n = sizes[si];
         uint32_t *keys = malloc((n ? n : 1) * 4), *want_keys = malloc((n ? n : 1) * 4),
@@ -117,11 +118,13 @@ static void test_sorts(pt_sorter *sorter, const uint32_t *sizes, int size_count)
         for (size_t bi = 0; bi < sizeof bit_cases / sizeof bit_cases[0]; bi++) {
             uint32_t b = bit_cases[bi], key_bits = b ? b : 23;
             for (uint32_t i = 0; i < n; i++)
-                keys[i] = b ? next_random() & ((1u << b) - 1) : 0x5A5A5Au;
+                keys[i] = b == 32 ? next_random() : b ? next_random() & ((1u << b) - 1) : 0x5A5A5Au;
             reference_sort(keys, n, want_keys, want_values);
             char what[64];
-            snprintf(what, sizeof what, "n = %u, %s", n, b ? (b == 1 ? "1-bit keys" : b == 8 ? "8-bit keys" : "23-bit keys")
-                                                           : "equal keys");
+            if (b)
+                snprintf(what, sizeof what, "n = %u, %u-bit keys", n, b);
+            else
+                snprintf(what, sizeof what, "n = %u, equal keys", n);
             check_sort(sorter, PT_SORT_RADIX, keys, n, key_bits, want_keys, want_values, what);
             check_sort(sorter, PT_SORT_BITONIC, keys, n, key_bits, want_keys, want_values, what);
         }
