@@ -295,6 +295,7 @@ sl_status pt_bin_table(pt_sorter *s, pt_lookup_method m, GLuint sorted_keys, uin
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, start);
     if (m == PT_LOOKUP_PREFIX_SUM) {
         const GLuint zero = 0;
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT); /* the clear comes after any shader write to start */
         glClearNamedBufferSubData(start, GL_R32UI, 0, ((GLsizeiptr)bins + 1) * 4, GL_RED_INTEGER, GL_UNSIGNED_INT,
                                   &zero);
         dispatch(s, ((size_t)n + LOOKUP_GROUP - 1) / LOOKUP_GROUP);
