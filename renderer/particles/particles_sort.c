@@ -159,6 +159,18 @@ static sl_status check_buffer(GLuint buffer, size_t bytes, const char *what, sl_
     return SL_OK;
 }
 
+/* SL_ERR_LIMIT when one shader storage block of `bytes` exceeds the GPU's
+ * GL_MAX_SHADER_STORAGE_BLOCK_SIZE (GL guarantees only 16 MiB). */
+static sl_status check_block_limit(size_t bytes, const char *what, sl_err *err)
+{
+    GLint64 limit = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &limit);
+    if (limit > 0 && bytes > (size_t)limit)
+        return sl_err_set(err, SL_ERR_LIMIT, "%s needs a %zu-byte shader storage block; this GPU allows %lld", what,
+                          bytes, (long long)limit);
+    return SL_OK;
+}
+
 static void dispatch(const pt_sorter *s, size_t groups)
 {
     sl_gpu_dispatch_chunked(LOC_GROUP_BASE, groups, s->max_groups);
@@ -211,6 +223,15 @@ static sl_status radix_sort(pt_sorter *s, GLuint keys, GLuint values, uint32_t n
     return SL_OK;
 }
 
+/* The bitonic network's size: the power of two >= n, at least one block. */
+static uint32_t bitonic_padded(uint32_t n)
+{
+    uint32_t padded = BITONIC_BLOCK;
+    while (padded < n)
+        padded *= 2;
+    return padded;
+}
+
 static void bitonic_local(const pt_sorter *s, size_t blocks, uint32_t k, GLuint flags)
 {
     glUseProgram(s->programs[PROGRAM_BITONIC_LOCAL]);
@@ -226,9 +247,7 @@ static sl_status bitonic_sort(pt_sorter *s, GLuint keys, GLuint values, uint32_t
         st = use_program(s, PROGRAM_BITONIC_GLOBAL, err);
     if (st != SL_OK)
         return st;
-    uint32_t padded = BITONIC_BLOCK;
-    while (padded < n)
-        padded *= 2;
+    uint32_t padded = bitonic_padded(n);
     size_t blocks = padded / BITONIC_BLOCK;
     scratch_reserve(&s->bitonic_pairs, (size_t)padded * 8);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, keys);
@@ -267,6 +286,9 @@ sl_status pt_sort_pairs(pt_sorter *s, pt_sort_method m, GLuint keys, GLuint valu
     if (st == SL_OK)
         st = check_buffer(values, (size_t)n * 4, "values", err);
     if (st == SL_OK)
+        st = check_block_limit(m == PT_SORT_RADIX ? (size_t)n * 4 : (size_t)bitonic_padded(n) * 8,
+                               m == PT_SORT_RADIX ? "GPU radix sort" : "GPU bitonic sort", err);
+    if (st == SL_OK)
         st = m == PT_SORT_RADIX ? radix_sort(s, keys, values, n, key_bits, err) : bitonic_sort(s, keys, values, n, err);
     if (st != SL_OK)
         return st;
@@ -285,6 +307,8 @@ sl_status pt_bin_table(pt_sorter *s, pt_lookup_method m, GLuint sorted_keys, uin
     sl_status st = check_buffer(start, ((size_t)bins + 1) * 4, "start", err);
     if (st == SL_OK && n > 0)
         st = check_buffer(sorted_keys, (size_t)n * 4, "sorted keys", err);
+    if (st == SL_OK)
+        st = check_block_limit(((size_t)bins + 1) * 4, "bin table", err);
     if (st == SL_OK)
         st = use_program(s, m == PT_LOOKUP_PREFIX_SUM ? PROGRAM_LOOKUP_HISTOGRAM : PROGRAM_LOOKUP_SEARCH, err);
     if (st != SL_OK)

@@ -46,7 +46,9 @@ void pt_sorter_set_max_groups(pt_sorter *s, unsigned max_groups);
  * (key, value) lexicographically, so with values = 0..n-1 in input order
  * both give identical output. Ends with a shader-storage and buffer-update
  * barrier. SL_ERR_INVALID: key_bits outside 1..32, a buffer smaller than n
- * u32; SL_ERR_LIMIT: n > PT_SORT_MAX_PAIRS; SL_ERR_GPU: a program failed to
+ * u32; SL_ERR_LIMIT: n > PT_SORT_MAX_PAIRS or a scratch buffer above the
+ * GPU's shader storage block size (radix 4n bytes, bitonic 8 per padded
+ * pair); SL_ERR_GPU: a program failed to
  * build or a GL call failed (sl_gl_check_errors; the buffers' contents are
  * then undefined). n = 0 or 1 does nothing. */
 sl_status pt_sort_pairs(pt_sorter *s, pt_sort_method m, GLuint keys, GLuint values, uint32_t n, uint32_t key_bits,
@@ -58,7 +60,8 @@ sl_status pt_sort_pairs(pt_sorter *s, pt_sort_method m, GLuint keys, GLuint valu
  * u32. Both methods give identical tables; prefix_sum does not even need the
  * keys sorted, binary_search does. Ends with a shader-storage barrier.
  * SL_ERR_INVALID: a buffer too small; SL_ERR_LIMIT: n > PT_SORT_MAX_PAIRS or
- * bins > PT_BINS_MAX; SL_ERR_GPU as pt_sort_pairs. */
+ * bins > PT_BINS_MAX or 4 (bins + 1) bytes above the block size; SL_ERR_GPU
+ * as pt_sort_pairs. */
 sl_status pt_bin_table(pt_sorter *s, pt_lookup_method m, GLuint sorted_keys, uint32_t n, uint32_t bins, GLuint start,
                        sl_err *err);
 
