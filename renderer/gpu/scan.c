@@ -1,6 +1,6 @@
 /* scan.c — the recursive driver of the exclusive u32 scan (sl_gpu_scan.h).
  *
- * Level 0 scans `in` into `out` in blocks of 512 and writes the block totals
+ * Level 0 scans `in` into `out` in blocks of 4096 and writes the block totals
  * to sums[0]; level L+1 scans sums[L] in place the same way, until one block
  * remains; then each level adds its scanned block totals back, deepest
  * first. Every dispatch is chunked at max_groups (sl_gpu_dispatch_chunked).
@@ -11,7 +11,7 @@
 #include <assert.h>
 #include <string.h>
 
-#define SCAN_BLOCK 512u
+#define SCAN_BLOCK 4096u /* scan.comp.glsl */
 
 sl_status sl_gpu_scan_init(sl_gpu_scan *s, sl_err *err)
 {
@@ -82,7 +82,7 @@ static void scan_level(sl_gpu_scan *s, int level, GLuint in, GLuint out, uint32_
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     if (blocks <= 1)
         return;
-    /* n < 2^32 gives at most 2^23, 2^14, 2^5, 1 blocks: level 3 is one block. */
+    /* n < 2^32 gives at most 2^20, 2^8, 1 blocks: level 2 is one block. */
     scan_level(s, level + 1, s->sums[level], s->sums[level], (uint32_t)blocks, UINT32_MAX);
     glUseProgram(s->add_program);
     glUniform1ui(s->add_n, n);

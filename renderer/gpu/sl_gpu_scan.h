@@ -1,8 +1,8 @@
 /* sl_gpu_scan.h — exclusive prefix sum of u32 buffers on the GPU (scan.c, gpu/glsl/scan.comp.glsl).
  *
- * Blocks of 512 values are scanned in shared memory; the block totals are
- * scanned the same way, recursively (at most SL_GPU_SCAN_LEVELS levels cover
- * any n < 2^32), and added back. An sl_gpu_scan owns the two programs and one
+ * Blocks of 4096 values are scanned by one work group; the block totals are
+ * scanned the same way, recursively (3 of the SL_GPU_SCAN_LEVELS levels
+ * cover any n < 2^32), and added back. An sl_gpu_scan owns the two programs and one
  * block-sum buffer per level, made at the first use and grown as needed, so
  * repeated scans allocate nothing. Sums wrap modulo 2^32 (callers keep totals
  * below it). Not done here: segmented scans, inclusive scans, other types.

@@ -13,7 +13,7 @@
 //             cap keeps the same lines as the CPU), pack the first `cap` codes
 //             into the line words (atomicOr: bits of one line are written by
 //             one invocation only) and sum their lengths (density).
-// The exclusive scans between passes run in voxel_scan.comp.glsl.
+// The exclusive scans between passes run in gpu/glsl/scan.comp.glsl (sl_gpu_scan.h).
 layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer vx_positions { float positions[]; };

@@ -2,7 +2,7 @@
  * against CPU references written here, and the shared GPU scan (gpu/sl_gpu_scan.h) they build on.
  *
  * Sorts: n in {0, 1, 2, 255, 256, 257, 1023, 1025, 65535, 65537, 200000},
- * keys random in [0, 2^b) for b in {1, 8, 23} and all equal, values 0..n-1:
+ * keys random in [0, 2^b) for b in {1, 8, 20, 23, 32} and all equal, values 0..n-1:
  * radix and bitonic must both equal the CPU stable sort word for word (so
  * radix is stable and bitonic orders by (key, value)). Tables: keys with
  * ~1/8 sentinels >= bins, GPU-sorted, for bins in {1, 1000, 2^20}: both
@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/sl_clock.h"
 #include "gpu/sl_gpu.h"
@@ -109,7 +110,8 @@ static void check_sort(pt_sorter *sorter, pt_sort_method m, const uint32_t *keys
 
 static void test_sorts(pt_sorter *sorter, const uint32_t *sizes, int size_count)
 {
-    static const uint32_t bit_cases[] = {1, 8, 23, 0}; /* 0: all keys equal */
+    /* Key bits (radix passes: 1, 2, 5 and 6, 8; odd counts end with the copy back); 0: all keys equal. */
+    static const uint32_t bit_cases[] = {1, 8, 20, 23, 32, 0};
     for (int si = 0; si < size_count; si++) {
         uint32_t n = sizes[si];
         uint32_t *keys = malloc((n ? n : 1) * 4), *want_keys = malloc((n ? n : 1) * 4),
@@ -117,11 +119,13 @@ static void test_sorts(pt_sorter *sorter, const uint32_t *sizes, int size_count)
         for (size_t bi = 0; bi < sizeof bit_cases / sizeof bit_cases[0]; bi++) {
             uint32_t b = bit_cases[bi], key_bits = b ? b : 23;
             for (uint32_t i = 0; i < n; i++)
-                keys[i] = b ? next_random() & ((1u << b) - 1) : 0x5A5A5Au;
+                keys[i] = b == 32 ? next_random() : b ? next_random() & ((1u << b) - 1) : 0x5A5A5Au;
             reference_sort(keys, n, want_keys, want_values);
             char what[64];
-            snprintf(what, sizeof what, "n = %u, %s", n, b ? (b == 1 ? "1-bit keys" : b == 8 ? "8-bit keys" : "23-bit keys")
-                                                           : "equal keys");
+            if (b)
+                snprintf(what, sizeof what, "n = %u, %u-bit keys", n, b);
+            else
+                snprintf(what, sizeof what, "n = %u, equal keys", n);
             check_sort(sorter, PT_SORT_RADIX, keys, n, key_bits, want_keys, want_values, what);
             check_sort(sorter, PT_SORT_BITONIC, keys, n, key_bits, want_keys, want_values, what);
         }
@@ -248,6 +252,15 @@ static void test_errors(pt_sorter *sorter)
     pt_sorter_destroy(NULL);
 }
 
+/* CPU time of the whole process (llvmpipe's threads included): comparable
+ * across runs when other work shares the cores, unlike the wall time. */
+static double process_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
 static double median5(double t[5])
 {
     for (int i = 0; i < 5; i++)
@@ -264,7 +277,8 @@ static double median5(double t[5])
 static int print_timings(pt_sorter *sorter)
 {
     static const uint32_t sizes[] = {10000, 60000, 200000};
-    printf("sort (key_bits 20)    n   radix ms  bitonic ms\n");
+    printf("wall ms to glFinish, median of 5 (process CPU ms in brackets)\n");
+    printf("sort, key_bits 20        n          radix          bitonic\n");
     for (int si = 0; si < 3; si++) {
         uint32_t n = sizes[si];
         uint32_t *keys = malloc(n * 4), *values = malloc(n * 4);
@@ -274,26 +288,29 @@ static int print_timings(pt_sorter *sorter)
         }
         GLuint pristine_keys = buffer_with(keys, n), pristine_values = buffer_with(values, n);
         GLuint kb = buffer_with(NULL, n), vb = buffer_with(NULL, n);
-        double ms[2];
+        double ms[2], cpu[2];
         for (int m = 0; m < 2; m++) {
-            double t[5];
+            double t[5], c[5];
             for (int r = -1; r < 5; r++) { /* r = -1: compiles the programs, grows the scratch */
                 glCopyNamedBufferSubData(pristine_keys, kb, 0, 0, (GLsizeiptr)n * 4);
                 glCopyNamedBufferSubData(pristine_values, vb, 0, 0, (GLsizeiptr)n * 4);
                 glFinish();
-                double t0 = sl_clock_ms();
+                double t0 = sl_clock_ms(), c0 = process_cpu_ms();
                 sl_err err;
                 if (pt_sort_pairs(sorter, (pt_sort_method)m, kb, vb, n, 20, &err) != SL_OK) {
                     fprintf(stderr, "%s\n", err.message);
                     return 1;
                 }
                 glFinish();
-                if (r >= 0)
+                if (r >= 0) {
                     t[r] = sl_clock_ms() - t0;
+                    c[r] = process_cpu_ms() - c0;
+                }
             }
             ms[m] = median5(t);
+            cpu[m] = median5(c);
         }
-        printf("%20s %6u %10.2f %11.2f\n", "", n, ms[0], ms[1]);
+        printf("%24s %6u %7.2f (%6.2f) %7.2f (%6.2f)\n", "", n, ms[0], cpu[0], ms[1], cpu[1]);
         GLuint names[4] = {pristine_keys, pristine_values, kb, vb};
         glDeleteBuffers(4, names);
         free(keys);
@@ -301,30 +318,33 @@ static int print_timings(pt_sorter *sorter)
     }
     const uint32_t n = 60000;
     uint32_t *keys = malloc(n * 4);
-    printf("table (n = %u)     bins   prefix_sum ms  binary_search ms\n", n);
+    printf("table, n = %u     bins     prefix_sum    binary_search\n", n);
     for (int e = 20; e <= 22; e += 2) {
         uint32_t bins = 1u << e;
         for (uint32_t i = 0; i < n; i++)
             keys[i] = (uint32_t)(((uint64_t)i * bins) / n); /* sorted, spread over the bins */
         GLuint kb = buffer_with(keys, n), sb = buffer_with(NULL, (size_t)bins + 1);
-        double ms[2];
+        double ms[2], cpu[2];
         for (int m = 0; m < 2; m++) {
-            double t[5];
+            double t[5], c[5];
             for (int r = -1; r < 5; r++) {
                 glFinish();
-                double t0 = sl_clock_ms();
+                double t0 = sl_clock_ms(), c0 = process_cpu_ms();
                 sl_err err;
                 if (pt_bin_table(sorter, (pt_lookup_method)m, kb, n, bins, sb, &err) != SL_OK) {
                     fprintf(stderr, "%s\n", err.message);
                     return 1;
                 }
                 glFinish();
-                if (r >= 0)
+                if (r >= 0) {
                     t[r] = sl_clock_ms() - t0;
+                    c[r] = process_cpu_ms() - c0;
+                }
             }
             ms[m] = median5(t);
+            cpu[m] = median5(c);
         }
-        printf("%20s 2^%d %14.2f %17.2f\n", "", e, ms[0], ms[1]);
+        printf("%24s   2^%d %7.2f (%6.2f) %7.2f (%6.2f)\n", "", e, ms[0], cpu[0], ms[1], cpu[1]);
         glDeleteBuffers(1, &kb);
         glDeleteBuffers(1, &sb);
     }
