@@ -99,8 +99,10 @@ int main(void)
     SL_CHECK(v3 > 0 && tclient_wait_version(&a, v3, T) == 0);
     sl_image third = tclient_decode_last(&a);
     double fg3 = harness_foreground_fraction(&third);
-    printf("after the error, isovalue 0.6: foreground %.3f\n", fg3);
+    double d3 = harness_mean_diff(&first, &third);
+    printf("after the error, isovalue 0.6: foreground %.3f, mean |diff| to isovalue 0.5 %.3f\n", fg3, d3);
     SL_CHECK_MSG(fg3 > 0.02, "no particles after a valid isovalue (foreground %.3f)", fg3);
+    SL_CHECK_MSG(d3 > 0.5, "the frame of isovalue 0.6 is the one of 0.5 (mean |diff| %.3f)", d3);
 
     sl_image_deinit(&first);
     sl_image_deinit(&second);
