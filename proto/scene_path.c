@@ -143,10 +143,12 @@ static int keyed(const sl_scene_path *p, const char *name)
     return 0;
 }
 
-/* Whether values of this schema type are interpolated (else they step). */
+/* Whether values of this schema type are interpolated (else they step): an
+ * int with unit "sets" is a bit mask, whose in-between values mean nothing. */
 static int interpolated(const sl_param_def *d)
 {
-    return d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3;
+    return d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_VEC3 ||
+           (d->type == SL_PARAM_INT && strcmp(d->unit, "sets") != 0);
 }
 
 /* The number of components of a number (1) or an array of numbers (its size <= 3), else 0. */

@@ -8,8 +8,12 @@
 // (colormaps too); vec3 with unit "rgb" -> a native colour input, any other
 // vec3 (directions, clip corners) -> three number fields clamped to
 // [min, max]; attribute -> select of the dataset's attribute names ("none" =
-// -1 when min is -1); transfer_function -> the editor of tf_editor.js.
-// Descriptions become tooltips; sliders and number fields also show their
+// -1 when min is -1); transfer_function -> the editor of tf_editor.js;
+// int with unit "sets" (a bit mask, bit k = set k) -> check boxes "set 0" …
+// "set 3"; values (0 … max_count numbers, [] = auto) -> a text field of
+// comma-separated numbers, checked against the schema range before it is
+// sent; transfer_2d -> a JSON text field with a one-line summary (shape
+// checked here, values by the server). Descriptions become tooltips; sliders and number fields also show their
 // range and unit ("0 … 1000 world"). Knows no technique or parameter by
 // name: the schema's type, range and unit alone pick the control.
 
@@ -44,6 +48,47 @@ function scaleFor(def) {
 }
 
 const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, v));
+
+// Check boxes of an int with unit "sets": 4, or fewer when max has fewer bits.
+export function setCount(def) {
+  return Math.max(1, Math.min(4, Math.floor(Math.log2(Math.max(1, def.max))) + 1));
+}
+
+// Text of a 'values' field -> { values } or { error }: comma-separated
+// numbers, empty = [] (auto), at most def.max_count (4), each in [min, max].
+export function parseValueList(text, def) {
+  const trimmed = String(text).trim();
+  if (trimmed === '') return { values: [] };
+  const parts = trimmed.split(',').map((t) => t.trim());
+  const most = def.max_count || 4;
+  if (parts.length > most) return { error: `at most ${most} values, got ${parts.length}` };
+  const values = [];
+  for (const [k, t] of parts.entries()) {
+    const v = t === '' ? NaN : Number(t);
+    if (!Number.isFinite(v)) return { error: `value ${k}: '${t}' is not a number` };
+    if (v < def.min || v > def.max) return { error: `value ${k}: ${t} is outside ${fmt(def.min)} … ${fmt(def.max)}` };
+    values.push(v);
+  }
+  return { values };
+}
+
+// Text of a 'transfer_2d' field -> { value } or { error }: the JSON form
+// {"range": r, "widgets": [[k1, k2, radius, r, g, b, a], ...]}, shape only.
+export function parseTransfer2d(text, def) {
+  let v;
+  try { v = JSON.parse(text); } catch (e) { return { error: 'not JSON' }; }
+  const most = def.max_widgets || 16;
+  if (!v || typeof v !== 'object' || Array.isArray(v) || typeof v.range !== 'number' || !Array.isArray(v.widgets)) {
+    return { error: 'expected {"range": r, "widgets": [[k1, k2, radius, r, g, b, a], ...]}' };
+  }
+  if (v.widgets.length < 1 || v.widgets.length > most) return { error: `1 to ${most} widgets, got ${v.widgets.length}` };
+  const bad = v.widgets.findIndex((w) => !Array.isArray(w) || w.length !== 7 || w.some((x) => typeof x !== 'number'));
+  if (bad >= 0) return { error: `widget ${bad}: expected 7 numbers [k1, k2, radius, r, g, b, a]` };
+  return { value: v };
+}
+
+const transfer2dSummary = (v) => (v && Array.isArray(v.widgets)
+  ? `${v.widgets.length} widget${v.widgets.length === 1 ? '' : 's'} over ±${fmt(v.range)}` : '');
 
 // The dataset's value range within the schema's, when the dataset is known and not constant.
 function dataRange(context, def) {
@@ -101,8 +146,10 @@ export class ParamControls {
     this.inputs.clear();
     this.context = context;
     for (const def of schema) {
-      // A label forwards clicks to its first input: not for the editor's canvas.
-      const row = document.createElement(def.type === 'transfer_function' ? 'div' : 'label');
+      // A label forwards clicks to its first input: not for the editor's
+      // canvas, nor for a group of check boxes (each has its own label).
+      const grouped = def.type === 'transfer_function' || (def.type === 'int' && def.unit === 'sets');
+      const row = document.createElement(grouped ? 'div' : 'label');
       row.className = 'param';
       row.title = def.description || '';
       const name = document.createElement('span');
@@ -110,7 +157,74 @@ export class ParamControls {
       name.textContent = def.name;
       row.append(name);
       let entry;
-      if (def.type === 'attribute') {
+      if (def.type === 'int' && def.unit === 'sets') {
+        // A bit mask over the technique's sets: one box per bit.
+        const boxes = [];
+        for (let k = 0; k < setCount(def); k++) {
+          const label = document.createElement('label');
+          label.className = 'set';
+          const box = document.createElement('input');
+          box.type = 'checkbox';
+          box.name = def.name; // update() leaves a focused control alone, by name
+          box.dataset.bit = String(k);
+          box.addEventListener('change', () => {
+            const mask = boxes.reduce((m, b, i) => m | (b.checked ? 1 << i : 0), 0);
+            this.onChange(def.name, clamp(mask, def.min, def.max));
+          });
+          label.append(box, ` set ${k}`);
+          boxes.push(box);
+        }
+        const group = document.createElement('span');
+        group.className = 'sets';
+        group.append(...boxes.map((b) => b.parentElement));
+        row.append(group);
+        entry = { def, set: (v) => { boxes.forEach((b, i) => { b.checked = ((Number(v) >> i) & 1) === 1; }); } };
+      } else if (def.type === 'values') {
+        const f = document.createElement('input');
+        f.type = 'text';
+        f.name = def.name;
+        f.className = 'list';
+        f.placeholder = 'auto';
+        const hint = `up to ${def.max_count || 4} of ${fmt(def.min, 'float')} … ${fmt(def.max, 'float')}` +
+          `${def.unit ? ` ${def.unit}` : ''}, comma-separated; empty = auto`;
+        const range = document.createElement('small');
+        range.className = 'range';
+        range.textContent = hint;
+        f.title = `${def.description ? `${def.description}. ` : ''}${hint}`;
+        const mark = (error) => {
+          f.setCustomValidity(error || '');
+          f.classList.toggle('invalid', !!error);
+          range.textContent = error ? `not sent: ${error}` : hint;
+        };
+        f.addEventListener('change', () => {
+          const r = parseValueList(f.value, def);
+          mark(r.error);
+          if (!r.error) this.onChange(def.name, r.values);
+        });
+        row.append(f, range);
+        entry = { def, set: (v) => { f.value = Array.isArray(v) ? v.join(', ') : ''; mark(null); } };
+      } else if (def.type === 'transfer_2d') {
+        // For now the JSON form; a 2D editor may replace it.
+        const f = document.createElement('textarea');
+        f.name = def.name;
+        f.className = 'json';
+        f.rows = 2;
+        f.spellcheck = false;
+        const summary = document.createElement('small');
+        summary.className = 'range';
+        const mark = (error, v) => {
+          f.setCustomValidity(error || '');
+          f.classList.toggle('invalid', !!error);
+          summary.textContent = error ? `not sent: ${error}` : transfer2dSummary(v);
+        };
+        f.addEventListener('change', () => {
+          const r = parseTransfer2d(f.value, def);
+          mark(r.error, r.value);
+          if (!r.error) this.onChange(def.name, r.value);
+        });
+        row.append(f, summary);
+        entry = { def, set: (v) => { f.value = JSON.stringify(v); mark(null, v); } };
+      } else if (def.type === 'attribute') {
         entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
       } else if (def.type === 'float' && def.max - def.min > WIDE_RANGE && def.unit === 'data' &&
                  dataRange(this.context, def)) {
@@ -237,7 +351,7 @@ export class ParamControls {
   }
 
   setEnabled(on) {
-    for (const el of this.form.querySelectorAll('input, select')) el.disabled = !on;
+    for (const el of this.form.querySelectorAll('input, select, textarea')) el.disabled = !on;
     for (const e of this.inputs.values()) if (e.editor) e.editor.setEnabled(on);
   }
 }

@@ -15,7 +15,8 @@
 // enum, int and float sliders, vec3 fields (clamped to the schema range), a
 // colour input (vec3 with unit "rgb"), number fields for ranges too wide for
 // a slider, attribute selects (built from the schema type alone; also
-// checked on a synthetic schema), technique and dataset pickers (the
+// checked on a synthetic schema), "sets" check boxes, value lists and 2D
+// transfer functions (on a synthetic schema: no technique uses them yet), technique and dataset pickers (the
 // technique picker lists only what renders the dataset's kind; picking a
 // volume switches to the first volume technique in one scene message and a
 // volume frame arrives), the transfer-function editor (a dragged opacity
@@ -516,6 +517,61 @@ async function synthetic(page) {
   check(same(ck.sent, [['zz_dir', [1, 0, 1]], ['zz_huge', -1e30]]), `typed values are clamped ${JSON.stringify(ck.sent)}`);
 }
 
+// The controls of the types no registered technique uses yet, on a
+// synthetic schema: an int with unit "sets" is 4 check boxes whose bits make
+// the value; a 'values' list is a text field whose numbers are sent only
+// when each lies in the schema range and there are at most max_count ([] =
+// auto); a 'transfer_2d' is a JSON field, sent when its shape is right.
+async function syntheticNewTypes(page) {
+  const r = await page.evaluate(async () => {
+    const { ParamControls } = await import('/controls.js');
+    const form = document.createElement('form');
+    const sent = [];
+    const pc = new ParamControls(form, (n, v) => sent.push([n, v]));
+    const tf2d = { range: 0.5, widgets: [[0.25, 0, 0.3, 0.95, 0.95, 0.9, 1], [0, -0.25, 0.3, 0.1, 0.1, 0.1, 1]] };
+    pc.build([
+      { name: 'zz_mask', type: 'int', min: 0, max: 15, default: 1, unit: 'sets', description: '' },
+      { name: 'zz_iso', type: 'values', min: 0, max: 255, max_count: 4, default: [], unit: 'data', description: '' },
+      { name: 'zz_ctf', type: 'transfer_2d', max_widgets: 16, default: tf2d, unit: '1/voxel', description: '' },
+      { name: 'zz_count', type: 'int', min: 0, max: 15, default: 1, unit: '', description: '' },
+    ]);
+    pc.update({ zz_mask: 5, zz_iso: [], zz_ctf: tf2d });
+    const boxes = [...form.querySelectorAll('input[type=checkbox][name=zz_mask]')];
+    const shownMask = boxes.map((b) => b.checked);
+    const labels = boxes.map((b) => b.parentElement.textContent.trim());
+    boxes[1].checked = true;
+    boxes[1].dispatchEvent(new Event('change'));
+    boxes[0].checked = false;
+    boxes[0].dispatchEvent(new Event('change'));
+    const iso = form.querySelector('input[name=zz_iso]');
+    const type = (el, text) => { el.value = text; el.dispatchEvent(new Event('change')); };
+    const shownIso = iso.value;
+    type(iso, '10, 20.5');
+    type(iso, '1, 2, 3, 4, 5');      // a 5th value: not sent
+    const fifthInvalid = iso.classList.contains('invalid');
+    type(iso, '10, 300');            // out of range: not sent
+    type(iso, '10, x');              // not a number: not sent
+    type(iso, '');                   // empty = auto
+    const ctf = form.querySelector('textarea[name=zz_ctf]');
+    const shownCtf = JSON.parse(ctf.value);
+    const summary = ctf.parentElement.querySelector('small').textContent;
+    type(ctf, '{"range": 1, "widgets": [[0, 0, 0.2, 1, 0, 0, 1]]}');
+    type(ctf, '{"range": 1, "widgets": [[0, 0, 0.2]]}'); // a short widget: not sent
+    type(ctf, '{"range": 1');                            // not JSON: not sent
+    return { shownMask, labels, shownIso, fifthInvalid, shownCtf, summary, sent,
+      countIsSlider: !!form.querySelector('input[type=range][name=zz_count]') };
+  });
+  check(same(r.shownMask, [true, false, true, false]) && same(r.labels, ['set 0', 'set 1', 'set 2', 'set 3']),
+    `"sets" check boxes show mask 5 ${JSON.stringify([r.shownMask, r.labels])}`);
+  check(r.countIsSlider, 'an int without unit "sets" stays a slider');
+  check(r.shownIso === '' && r.fifthInvalid, `values field: empty = auto, a 5th value marked ${JSON.stringify(r)}`);
+  check(same(r.shownCtf, { range: 0.5, widgets: [[0.25, 0, 0.3, 0.95, 0.95, 0.9, 1], [0, -0.25, 0.3, 0.1, 0.1, 0.1, 1]] }) &&
+    r.summary === '2 widgets over ±0.5', `transfer_2d field shows the value ${JSON.stringify([r.shownCtf, r.summary])}`);
+  check(same(r.sent, [['zz_mask', 7], ['zz_mask', 6], ['zz_iso', [10, 20.5]], ['zz_iso', []],
+    ['zz_ctf', { range: 1, widgets: [[0, 0, 0.2, 1, 0, 0, 1]] }]]),
+  `sets / values / transfer_2d send only valid values ${JSON.stringify(r.sent)}`);
+}
+
 // Control hand-over: the viewer asks, the controller grants, the server says
 // so, the new controller's change reaches the server, the old one is a viewer.
 async function handOver(page, page2, obs, sess) {
@@ -683,6 +739,7 @@ async function main() {
     const selects = await page.$$eval('#params select[data-type=attribute]', (xs) => xs.map((x) => x.name));
     check(typed.length >= 2 && same(typed, selects), `attribute selects ${JSON.stringify(selects)} = schema's ${JSON.stringify(typed)}`);
     await synthetic(page);
+    await syntheticNewTypes(page);
 
     // 3b. Snapshot button downloads a PNG; a named view is saved and listed.
     const [download] = await Promise.all([page.waitForEvent('download', { timeout: T }), page.click('#snapshot')]);

@@ -9,7 +9,8 @@
  * slerped view direction, up orthogonal on 2000 samples of random keys),
  * opposite view directions, times outside the keys. Paths in scenes: frame
  * counts, keyframed params (linear numbers, rounded ints, stepping bools and
- * choices, vec3 by component, held before a parameter's first key), the
+ * choices, vec3 by component, held before a parameter's first key; bit masks
+ * of unit "sets" and value lists step), the
  * prepared-level list, and every malformed path refused with the field
  * named. No GL.
  */
@@ -176,6 +177,13 @@ static double number_of(const cJSON *o, const char *name)
     return cJSON_IsNumber(v) ? v->valuedouble : NAN;
 }
 
+static const sl_param_def masks_params[] = {
+    {"sides", SL_PARAM_INT, 0, 31, {1}, NULL, "sets", "a bit mask", SL_INVALIDATE_FRAME},
+    {"color", SL_PARAM_VALUES, 0, 1, {0}, NULL, "", "a list", SL_INVALIDATE_FRAME},
+};
+static const sl_technique masks_technique = {.name = "masks", .description = "test-only", .params = masks_params,
+                                             .param_count = 2};
+
 static void test_scene_paths(void)
 {
     sl_scene s;
@@ -201,6 +209,19 @@ static void test_scene_paths(void)
     cJSON_Delete(p);
     char names[128];
     SL_CHECK(sl_scene_path_prepared_params(s.path, tech, names, sizeof names) == 1 && strcmp(names, "sides") == 0);
+    /* The same keys read by a schema where "sides" is a bit mask (unit
+     * "sets") and "color" a value list: both step, never blend. */
+    p = sl_scene_path_params(s.path, 0.5, s.params, &masks_technique);
+    SL_CHECK_NEAR(number_of(p, "sides"), 8.0, 0.0);
+    cJSON_Delete(p);
+    p = sl_scene_path_params(s.path, 1.6, s.params, &masks_technique);
+    SL_CHECK_NEAR(number_of(p, "sides"), 8.0, 0.0);
+    color = cJSON_GetObjectItemCaseSensitive(p, "color");
+    SL_CHECK(cJSON_GetArraySize(color) == 3 && cJSON_GetArrayItem(color, 1)->valuedouble == 0.0);
+    cJSON_Delete(p);
+    p = sl_scene_path_params(s.path, 2.1, s.params, &masks_technique);
+    SL_CHECK_NEAR(number_of(p, "sides"), 16.0, 0.0);
+    cJSON_Delete(p);
     sl_scene_deinit(&s);
 }
 
