@@ -3,7 +3,8 @@
  * Using GPU-Based Particle Systems", IEEE TVCG 2010; README.md).
  *
  * prepare uploads the volume (exact values) and builds one particle set per
- * isovalue (particles_system.h: placement, redistribution, curvature) —
+ * isovalue (particles_system.h: placement, redistribution, curvature), or
+ * takes a finished one from particles_cache.h —
  * only the PREPARED parameters (isovalues, lattice spacing, repulsion
  * radius, the stopping rule, sort, look-up, the particle cap) change the
  * particles, so a camera move or a style change never recomputes them.
@@ -22,6 +23,7 @@
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
 #include "../volume/sl_volume.h"
+#include "particles_cache.h"
 #include "particles_frame.h"
 #include "particles_hsr.h"
 #include "particles_stipple.h"
@@ -206,14 +208,26 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
                            .sort = (pt_sort_method)sl_params_choice(params, "sort"),
                            .lookup = (pt_lookup_method)sl_params_choice(params, "lookup"),
                            .max_particles = (uint32_t)sl_params_int(params, "max_particles")};
+    uint64_t volume_hash = pt_cache_volume_hash(&ds->volume);
+    int cached = 0;
     for (built = 0; built < s->set_count; built++) {
         desc.iso = s->iso[built];
-        if ((st = pt_set_build(s->system, &field, &desc, &s->sets[built], err)) != SL_OK) {
+        int hit = pt_cache_lookup(volume_hash, &desc, &s->sets[built], err);
+        if (hit < 0) {
+            st = SL_ERR_GPU;
+            goto fail;
+        }
+        if (hit) {
+            cached++;
+        } else if ((st = pt_set_build(s->system, &field, &desc, &s->sets[built], err)) != SL_OK) {
             sl_err_prefix(err, "set %d (isovalue %g)", built, s->iso[built]);
             goto fail;
+        } else {
+            pt_cache_store(volume_hash, &desc, &s->sets[built]);
         }
         s->gpu_bytes += s->sets[built].bytes;
     }
+    sl_prepare_stats_add(&s->prep, "sets_cached", cached);
     glCreateVertexArrays(1, &s->vao);
     GLfloat range[2] = {1, 64};
     glGetFloatv(GL_POINT_SIZE_RANGE, range);

@@ -254,3 +254,13 @@ set_target_properties(test_particles_probe PROPERTIES RUNTIME_OUTPUT_DIRECTORY $
 add_test(NAME unit.test_particles_probe COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_particles_probe>
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(unit.test_particles_probe PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
+
+# ---- what a prepare recomputes: camera moves and style changes never;
+# a new isovalue list only the sets not in the cache (particles_cache.h).
+add_executable(test_particles_cache ${PT_DIR}/test_particles_cache.c)
+target_include_directories(test_particles_cache PRIVATE ${CMAKE_SOURCE_DIR}/tests/unit ${CMAKE_SOURCE_DIR}/proto)
+target_link_libraries(test_particles_cache PRIVATE sightline_proto sightline_renderer PkgConfig::CJSON)
+set_target_properties(test_particles_cache PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+add_test(NAME unit.test_particles_cache COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_particles_cache>
+  WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+set_tests_properties(unit.test_particles_cache PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
