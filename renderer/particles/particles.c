@@ -345,7 +345,7 @@ static sl_status particles_export(void *opaque, const sl_params *params, const c
         }
         glGetNamedBufferSubData(s->sets[k].records, 0, (GLsizeiptr)((size_t)n * sizeof *r), r);
         for (uint32_t i = 0; i < n; i++)
-            fprintf(f, "%d,%.9g,%.9g,%.9g,%.7g,%.7g,%.7g,%.7g,%.7g,%.6g\n", k, s->geom.origin.x + r[i].x[0],
+            fprintf(f, "%d,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", k, s->geom.origin.x + r[i].x[0],
                     s->geom.origin.y + r[i].x[1], s->geom.origin.z + r[i].x[2], r[i].n[0], r[i].n[1], r[i].n[2],
                     r[i].k1, r[i].k2, reliability(r[i].k1, r[i].k2, eps));
         free(r);

@@ -264,3 +264,18 @@ set_target_properties(test_particles_cache PROPERTIES RUNTIME_OUTPUT_DIRECTORY $
 add_test(NAME unit.test_particles_cache COMMAND ${SL_TEST_RUN} $<TARGET_FILE:test_particles_cache>
   WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
 set_tests_properties(unit.test_particles_cache PROPERTIES ENVIRONMENT "${SL_TEST_ENV}" TIMEOUT 300)
+
+# ---- huge coordinates: the sphere's voxels written with voxel (0,0,0) at
+# (1e5, -2e5, 3e5) give the same particles (positions are stored relative to
+# the volume's origin; measured: position, normal and curvature differences
+# 0) and the same image; the twin judges them against an origin 1e-3 off.
+set(PT_FAR_ORIGIN 100000,-200000,300000)
+pt_test(export.huge_offset ${CMAKE_COMMAND}
+  "-DSTEP1=${PT_CHECK}|write-volume|--dataset|${PT_SPHERE64}|--origin|${PT_FAR_ORIGIN}|--out|${PT_OUT}/far_sphere"
+  "-DSTEP2=${PT_RENDER}|--scene|${PT_BASE}|--out|${PT_OUT}/near.png|--export|${PT_OUT}/near.csv"
+  "-DSTEP3=${PT_RENDER}|--scene|${PT_BASE}|--set|dataset=${PT_OUT}/far_sphere.nhdr|--out|${PT_OUT}/far.png|--export|${PT_OUT}/far.csv"
+  "-DSTEP4=${PT_CHECK}|offset|--dataset|${PT_SPHERE64}|--csv|${PT_OUT}/near.csv|--csv-b|${PT_OUT}/far.csv|--origin|${PT_FAR_ORIGIN}"
+  "-DSTEP5=${CMAKE_COMMAND}|-E|compare_files|${PT_OUT}/near.png|${PT_OUT}/far.png"
+  "-DSTEP6=${PT_CHECK}|offset|--dataset|${PT_SPHERE64}|--csv|${PT_OUT}/near.csv|--csv-b|${PT_OUT}/far.csv|--origin|100000.001,-200000,300000"
+  -DEXIT6=1 "-DERR6=FAIL: far from the origin the particles moved"
+  ${SL_STEPS})

@@ -10,6 +10,9 @@
  *        particles-check placement --dataset D --stats S --iso V --spacing S [--set K]
  *        particles-check count --csv C --stats S [--set K] [--min N] [--max N]
  *        particles-check depth --pfm P [--min N] [--max N]
+ *        particles-check write-volume --dataset D --origin X,Y,Z --out BASE
+ *        particles-check offset --dataset D --csv A --csv-b B --origin X,Y,Z [--max-pos E] [--max-normal E]
+ *                        [--max-rel-k E]
  *
  * surface: for every exported particle of set K (default 0), its distance to
  *   the isosurface to first order, |f(p) - iso| / |grad f(p)| with f the
@@ -36,6 +39,16 @@
  *   [N_min, N_max] (defaults 0 and unlimited).
  * depth: every value of the depth map (PFM, eye distance, 0 = no hit) is
  *   finite and >= 0, and the hit pixels number within [N_min, N_max].
+ * write-volume: writes the scalar volume D as BASE.nhdr + BASE.raw (f32)
+ *   with its voxel (0,0,0) at world X,Y,Z (the same voxels and spacing):
+ *   the same data far from the world origin.
+ * offset: two exports of the same voxels (--dataset D names the first), A at
+ *   D's own origin, B from write-volume at X,Y,Z: row for row the same set,
+ *   positions equal after subtracting each origin within E (world, default
+ *   1e-5),
+ *   normals within --max-normal (default 1e-6), curvatures within
+ *   --max-rel-k of the largest |k| (default 1e-6): huge coordinates lose no
+ *   precision (positions are stored relative to the volume's origin).
  * exit: 0 pass, 1 a limit failed, 2 bad input. Any thread, no GL.
  */
 #include <math.h>
@@ -50,7 +63,9 @@
 #include "particles_reference.h"
 
 typedef struct options {
-    const char *dataset, *csv, *stats, *shape, *pfm;
+    const char *dataset, *csv, *csv_b, *stats, *shape, *pfm, *out;
+    double origin[3], max_pos, max_normal, max_rel_k;
+    int have_origin;
     double iso, max_dist, pct, area, max_cv, ratio_lo, ratio_hi, spacing;
     double center[3], axes[3], radius, major, minor, min_rho, eps, max_mean_rel, max_p90_rel;
     double count_min, count_max;
@@ -67,7 +82,10 @@ static int usage(void)
             "                       [--min-rho R] [--eps E] [--max-mean-rel X] [--max-p90-rel X]\n"
             "       particles-check placement --dataset D --stats S --iso V --spacing S [--set K]\n"
             "       particles-check count --csv C --stats S [--set K] [--min N] [--max N]\n"
-            "       particles-check depth --pfm P [--min N] [--max N]\n");
+            "       particles-check depth --pfm P [--min N] [--max N]\n"
+            "       particles-check write-volume --dataset D --origin X,Y,Z --out BASE\n"
+            "       particles-check offset --csv A --csv-b B --origin X,Y,Z [--max-pos E] [--max-normal E]\n"
+            "                              [--max-rel-k E]\n");
     return 2;
 }
 
@@ -86,7 +104,8 @@ static int parse_vec3(const char *s, double v[3])
 static int parse_options(int argc, char **argv, options *o)
 {
     *o = (options){.max_dist = 0.05, .pct = 99, .max_cv = 0.25, .ratio_lo = 0.6, .ratio_hi = 1.0,
-                   .max_mean_rel = 0.05, .max_p90_rel = -1, .count_max = 1e300, .iso = NAN, .spacing = NAN};
+                   .max_mean_rel = 0.05, .max_p90_rel = -1, .count_max = 1e300, .iso = NAN, .spacing = NAN,
+                   .max_pos = 1e-5, .max_normal = 1e-6, .max_rel_k = 1e-6};
     for (int i = 2; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--inward") == 0) {
@@ -102,6 +121,12 @@ static int parse_options(int argc, char **argv, options *o)
         else if (strcmp(a, "--stats") == 0) o->stats = v;
         else if (strcmp(a, "--shape") == 0) o->shape = v;
         else if (strcmp(a, "--pfm") == 0) o->pfm = v;
+        else if (strcmp(a, "--csv-b") == 0) o->csv_b = v;
+        else if (strcmp(a, "--out") == 0) o->out = v;
+        else if (strcmp(a, "--origin") == 0) { if (parse_vec3(v, o->origin)) return -1; o->have_origin = 1; }
+        else if (strcmp(a, "--max-pos") == 0) num = &o->max_pos;
+        else if (strcmp(a, "--max-normal") == 0) num = &o->max_normal;
+        else if (strcmp(a, "--max-rel-k") == 0) num = &o->max_rel_k;
         else if (strcmp(a, "--center") == 0) { if (parse_vec3(v, o->center)) return -1; }
         else if (strcmp(a, "--axes") == 0) { if (parse_vec3(v, o->axes)) return -1; o->have_axes = 1; }
         else if (strcmp(a, "--set") == 0) o->set = atoi(v);
@@ -457,6 +482,100 @@ static int check_depth(const options *o)
     return 0;
 }
 
+static int write_volume(const options *o)
+{
+    if (!o->dataset || !o->out || !o->have_origin)
+        return usage();
+    sl_dataset *ds = open_dataset(o->dataset);
+    if (!ds)
+        return 2;
+    const sl_volume *vol = &ds->volume;
+    char path[1024], raw_name[1024];
+    const char *slash = strrchr(o->out, '/');
+    snprintf(raw_name, sizeof raw_name, "%s.raw", slash ? slash + 1 : o->out);
+    snprintf(path, sizeof path, "%s.raw", o->out);
+    FILE *raw = fopen(path, "wb");
+    int rc = raw ? 0 : 2;
+    for (int z = 0; raw && z < vol->dims[2]; z++)
+        for (int y = 0; y < vol->dims[1]; y++)
+            for (int x = 0; x < vol->dims[0]; x++) {
+                float v = (float)sl_volume_value(vol, (size_t)x, (size_t)y, (size_t)z, 0);
+                rc |= fwrite(&v, sizeof v, 1, raw) != 1 ? 2 : 0;
+            }
+    if (raw && fclose(raw) != 0)
+        rc = 2;
+    snprintf(path, sizeof path, "%s.nhdr", o->out);
+    FILE *hdr = rc ? NULL : fopen(path, "w");
+    if (hdr) {
+        fprintf(hdr, "NRRD0004\ntype: float\ndimension: 3\nsizes: %d %d %d\nspacings: %.17g %.17g %.17g\n"
+                     "space origin: (%.17g,%.17g,%.17g)\nendian: little\nencoding: raw\ndata file: %s\n",
+                vol->dims[0], vol->dims[1], vol->dims[2], vol->spacing[0], vol->spacing[1], vol->spacing[2],
+                o->origin[0], o->origin[1], o->origin[2], raw_name);
+        rc = fclose(hdr) != 0 ? 2 : 0;
+    } else {
+        rc = 2;
+    }
+    if (rc)
+        fprintf(stderr, "particles-check: cannot write %s\n", o->out);
+    else
+        printf("write-volume: %s.nhdr (%d x %d x %d, origin %g, %g, %g)\n", o->out, vol->dims[0], vol->dims[1],
+               vol->dims[2], o->origin[0], o->origin[1], o->origin[2]);
+    sl_dataset_destroy(ds);
+    return rc;
+}
+
+static int check_offset(const options *o)
+{
+    if (!o->csv || !o->csv_b || !o->have_origin || !o->dataset)
+        return usage();
+    sl_dataset *ds = open_dataset(o->dataset);
+    if (!ds)
+        return 2;
+    const double base[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
+    sl_dataset_destroy(ds);
+    pref_csv_row *a = NULL, *b = NULL;
+    size_t na = 0, nb = 0;
+    char err[256];
+    if (pref_csv_read(o->csv, &a, &na, err, sizeof err) != 0 || pref_csv_read(o->csv_b, &b, &nb, err, sizeof err) != 0) {
+        fprintf(stderr, "particles-check: %s\n", err);
+        free(a);
+        return 2;
+    }
+    double pos = 0.0, normal = 0.0, kmax = 0.0, kdiff = 0.0;
+    int rc = 0;
+    if (na != nb || na == 0) {
+        fprintf(stderr, "FAIL: %zu particles at the dataset's origin, %zu far away\n", na, nb);
+        rc = 1;
+    }
+    for (size_t i = 0; !rc && i < na; i++) {
+        if (a[i].set != b[i].set) {
+            fprintf(stderr, "FAIL: row %zu: set %d and %d\n", i + 1, a[i].set, b[i].set);
+            rc = 1;
+            break;
+        }
+        for (int c = 0; c < 3; c++) {
+            pos = fmax(pos, fabs((b[i].p[c] - o->origin[c]) - (a[i].p[c] - base[c])));
+            normal = fmax(normal, fabs(b[i].n[c] - a[i].n[c]));
+        }
+        kmax = fmax(kmax, fmax(fabs(a[i].k1), fabs(a[i].k2)));
+        kdiff = fmax(kdiff, fmax(fabs(a[i].k1 - b[i].k1), fabs(a[i].k2 - b[i].k2)));
+    }
+    if (!rc) {
+        double krel = kmax > 0 ? kdiff / kmax : kdiff;
+        printf("offset: %zu particles; position %.3g, normal %.3g, curvature %.3g of max |k|\n", na, pos, normal,
+               krel);
+        if (!(pos <= o->max_pos) || !(normal <= o->max_normal) || !(krel <= o->max_rel_k)) {
+            fprintf(stderr, "FAIL: far from the origin the particles moved: position %.3g (max %.3g), normal %.3g "
+                            "(max %.3g), curvature %.3g (max %.3g)\n",
+                    pos, o->max_pos, normal, o->max_normal, krel, o->max_rel_k);
+            rc = 1;
+        }
+    }
+    free(a);
+    free(b);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     options o;
@@ -474,5 +593,9 @@ int main(int argc, char **argv)
         return check_count(&o);
     if (strcmp(argv[1], "depth") == 0)
         return check_depth(&o);
+    if (strcmp(argv[1], "write-volume") == 0)
+        return write_volume(&o);
+    if (strcmp(argv[1], "offset") == 0)
+        return check_offset(&o);
     return usage();
 }
