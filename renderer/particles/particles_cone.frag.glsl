@@ -16,7 +16,7 @@ layout(location = 0) out uint o_id;
 void main()
 {
     float depth;
-    if (!pt_cone_fragment(gl_FragCoord.xy, v_center, v_normal, u_cone_radius, depth))
+    if (!pt_cone_fragment(gl_FragCoord.xy, v_center, v_normal, u_cone_radius, true, depth))
         discard;
     o_id = v_id;
     gl_FragDepth = depth;

@@ -21,7 +21,7 @@ layout(location = 0) out vec4 o_color;
 void main()
 {
     float depth;
-    if (!pt_cone_fragment(gl_FragCoord.xy, v_center, v_normal, u_cone_radius, depth))
+    if (!pt_cone_fragment(gl_FragCoord.xy, v_center, v_normal, u_cone_radius, false, depth))
         discard;
     vec3 n = v_normal;
     if (dot(n, sl_eye.xyz - v_center) < 0.0)
