@@ -67,7 +67,7 @@ static int parse_options(int argc, char **argv, options *o)
 {
     *o = (options){.azimuth = 0, .distance = 2.5, .fov = 45, .far_px = 3, .max_far_share = 0.02,
                    .min_cover = 0.95, .min_corr = 0.9, .ink = {0.05, 0.05, 0.05}, .light = {0.3, 0.5, 1.0}};
-    for (int i = 2; i < argc; i++) {
+    for (int i = 2; i < argc; i += 2) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         double *num = NULL;
         if (!v)
@@ -97,7 +97,6 @@ static int parse_options(int argc, char **argv, options *o)
             if (end == v || *end)
                 return 0;
         }
-        i++;
     }
     return o->png && o->dataset && o->radius > 0;
 }
