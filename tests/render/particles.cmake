@@ -262,9 +262,14 @@ endmacro()
 # Contour width: the ink integrated across the silhouette at 360 angles,
 # median within max(25 %, 1 px) of contour_width at two zooms (the line
 # keeps its screen width). Measured median (p10, p90), px: width 2 at
-# distance 2.5 MEAS_2_25, at 5 MEAS_2_5; width 4 at 2.5 MEAS_4_25, at 5
-# MEAS_4_5. The twin judges the far width-2 image as if the width were 4
-# (a width in world units would halve from 2.5 to 5) and must fail.
+# distance 2.5: 2.63 (2.26, 2.88), at 5: 2.40 (2.10, 2.70); width 4 at 2.5:
+# 4.59 (4.25, 4.85), at 5: 4.46 (4.11, 4.69). The 0.4-0.6 px over are the
+# coverage ramps of overlapping segments adding up; the line's centre lies
+# on the circle (mean radius 32.30 px against 32.29). The move onto the
+# contour matters: the plan's first-order move alone gives 3.72 px at width
+# 2 (the points land up to T outside), no move 3.84 px: both fail. The twin
+# judges the far width-2 image as if the width were 4 (a width in world
+# units would halve from 2.5 to 5) and must fail.
 foreach(w 2 4)
   foreach(d 2.5 5)
     pt_side_on(contour_w${w}_d${d} "{\"isovalues\":[0.5],\"stipple\":0,\"contours\":1,\"contour_width\":${w},\"set0_color\":[0.05,0.05,0.05]}" ${d})
@@ -277,8 +282,9 @@ pt_test(contours.detects_world_width ${CMAKE_COMMAND}
   "-DSTEP1=${PT_CCHECK}|width|${PT_SIDE_ON_ARGS}|--width|4" -DEXIT1=1 "-DERR1=FAIL: contour width" ${SL_STEPS})
 set_tests_properties(render.particles.contours.detects_world_width PROPERTIES DEPENDS render.particles.contours.width_2_d5)
 # Contours only near the silhouette: ink pixels farther than 3 px from the
-# circle (width 2, distance 2.5), measured share MEAS_NEAR (bound 0.02); the
-# twin adds the stipples (ink all over the disk) and must fail.
+# circle (width 2, distance 2.5), measured share 0 of 567 (bound 0.02; 0.028
+# with the first-order move only); the twin adds the stipples (ink all over
+# the disk: 0.47) and must fail.
 pt_side_on(contour_near "{\"isovalues\":[0.5],\"stipple\":0,\"contours\":1,\"set0_color\":[0.05,0.05,0.05]}" 2.5)
 pt_test(contours.near_silhouette ${CMAKE_COMMAND} "-DSTEP1=${PT_SIDE_ON}"
   "-DSTEP2=${PT_CCHECK}|near|${PT_SIDE_ON_ARGS}|--far-px|3|--max-far-share|0.02" ${SL_STEPS})
@@ -287,12 +293,12 @@ pt_test(contours.detects_ink_off_silhouette ${CMAKE_COMMAND} "-DSTEP1=${PT_SIDE_
   "-DSTEP2=${PT_CCHECK}|near|${PT_SIDE_ON_ARGS}|--far-px|3|--max-far-share|0.02"
   -DEXIT2=1 "-DERR2=FAIL: ink away from the silhouette" ${SL_STEPS})
 # Splats close the surface and are shaded: inside the projected disk (1.5 px
-# inset) the covered share, measured MEAS_COVER (bound 0.97), and the
+# inset) the covered share, measured 0.9993 (bound 0.97), and the
 # correlation of the luminance with max(0, n.l) of the sphere, measured
-# MEAS_CORR (bound 0.9), the ink a light grey on black (the unlit side,
+# 0.9985 (bound 0.9; mean luminance 0.19 where n.l < 0.25, 0.81 above 0.75), the ink a light grey on black (the unlit side,
 # ambient 0.1, stays apart from the background).
-# Twins: disks of 0.3 mean spacings leave gaps (cover MEAS_GAPS); judged with
-# the light reversed, the shading correlates negatively.
+# Twins: disks of 0.3 mean spacings leave gaps (cover 0.960); judged with the
+# light reversed, the shading correlates negatively (-0.26).
 foreach(case "splat;1" "splat_small;0.3")
   list(GET case 0 name)
   list(GET case 1 radius)
