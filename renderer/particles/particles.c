@@ -25,7 +25,9 @@
 #include "../volume/sl_volume.h"
 #include "particles_cache.h"
 #include "particles_frame.h"
+#include "particles_contours.h"
 #include "particles_hsr.h"
+#include "particles_splat.h"
 #include "particles_stipple.h"
 #include "particles_system.h"
 
@@ -69,6 +71,17 @@ static const sl_param_def particles_params[] = {
      SL_INVALIDATE_FRAME},
     {"stipple_contrast", SL_PARAM_FLOAT, 0.0, 8.0, {1.0}, NULL, "", "stretches the tone about its middle",
      SL_INVALIDATE_FRAME},
+    {"splat", SL_PARAM_INT, 0, 15, {0}, NULL, "sets",
+     "per set: draw the hidden-surface cones as opaque disks, Lambert-shaded in the set's ink (Fig. 10a)",
+     SL_INVALIDATE_FRAME},
+    {"contours", SL_PARAM_INT, 0, 15, {0}, NULL, "sets", "per set: draw contours (sec. 4.2.4)", SL_INVALIDATE_FRAME},
+    {"contour_distance", SL_PARAM_FLOAT, 0.0, 4.0, {1.0}, NULL, "nn",
+     "particles that project within this many mean nearest-neighbour distances of a contour draw a piece of it",
+     SL_INVALIDATE_FRAME},
+    {"contour_length", SL_PARAM_FLOAT, 0.2, 4.0, {1.2}, NULL, "nn",
+     "length of each particle's contour segment, in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
+    {"contour_width", SL_PARAM_FLOAT, 0.5, 16.0, {2.0}, NULL, "px", "width of the contour lines on screen",
+     SL_INVALIDATE_FRAME},
     {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
     {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
     {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
@@ -87,6 +100,8 @@ typedef struct particles_state {
     pt_set sets[PT_MAX_SETS];
     pt_hsr hsr;
     pt_stipple stipple;
+    pt_splat splat;
+    pt_contours contours;
     GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
@@ -104,6 +119,8 @@ static void particles_release(void *opaque)
     sl_volume_texture_destroy(&s->volume);
     pt_hsr_deinit(&s->hsr);
     pt_stipple_deinit(&s->stipple);
+    pt_splat_deinit(&s->splat);
+    pt_contours_deinit(&s->contours);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -188,7 +205,8 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     if ((st = pt_system_create(&s->system, err)) != SL_OK || (st = pt_hsr_init(&s->hsr, err)) != SL_OK ||
-        (st = pt_stipple_init(&s->stipple, err)) != SL_OK)
+        (st = pt_stipple_init(&s->stipple, err)) != SL_OK || (st = pt_splat_init(&s->splat, err)) != SL_OK ||
+        (st = pt_contours_init(&s->contours, err)) != SL_OK)
         goto fail;
     pt_field field = {.texture = s->volume.tex,
                       .value_scale = s->volume.value_scale,
@@ -250,6 +268,18 @@ static double luminance(const float c[3])
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
+/* The per-set style switches (INT "sets" masks): a set draws when any of
+ * its bits is on. A new style adds its switch here. */
+static const char *const style_masks[] = {"stipple", "splat", "contours", NULL};
+
+static int any_style_mask(const sl_params *params)
+{
+    int mask = 0;
+    for (int i = 0; style_masks[i]; i++)
+        mask |= sl_params_int(params, style_masks[i]);
+    return mask;
+}
+
 static sl_status particles_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                                   sl_render_stats *stats, sl_err *err)
 {
@@ -266,7 +296,7 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
     double drawn = 0.0;
     for (int k = 0; k < s->set_count; k++) {
         const pt_set *set = &s->sets[k];
-        int styles = stipple_mask;
+        int styles = any_style_mask(params);
         if (set->stats.alive == 0 || !(styles >> k & 1))
             continue;
         pt_set_view sv = {.set = set, .index = k};
@@ -285,8 +315,17 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
             sv.hsr = 1;
             sv.id_tex = s->hsr.ids;
         }
+        if (sl_params_int(params, "splat") >> k & 1)
+            drawn += pt_splat_draw(&s->splat, &frame, &sv, cone_radius);
         if (stipple_mask >> k & 1)
             drawn += pt_stipple_draw(&s->stipple, &frame, &sv, params);
+        if (sl_params_int(params, "contours") >> k & 1) {
+            double sigma = sl_params_float(params, "repulsion_radius") * sl_params_float(params, "spacing") *
+                           s->geom.min_spacing;
+            sl_status st = pt_contours_draw(&s->contours, &frame, &sv, params, sigma, err);
+            if (st != SL_OK)
+                return st;
+        }
     }
     glDisable(GL_BLEND);
     glBindTextureUnit(0, 0);
@@ -303,7 +342,7 @@ static size_t particles_gpu_bytes(const void *opaque)
     const particles_state *s = opaque;
     if (!s)
         return 0;
-    return s->gpu_bytes + pt_hsr_bytes(&s->hsr);
+    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_contours_bytes(&s->contours);
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)

@@ -1,10 +1,11 @@
 // particles_cone.vert.glsl — hidden-surface removal, pass 1 (the paper's
 // Algorithm 3): every alive particle of the set as a cone sprite, a point
 // large enough for its tangent disk of radius u_cone_radius (world) on
-// screen; particles_cone.frag.glsl cuts the disk and writes the cone's depth
-// and the particle's id + 1 into the id target.
+// screen (particles_cone.glsl); particles_cone.frag.glsl cuts the disk and
+// writes the cone's depth and the particle's id + 1 into the id target.
 #include "gpu/glsl/camera.glsl"
 #include "particles/particles_record.glsl"
+#include "particles/particles_cone.glsl"
 
 uniform float u_cone_radius;
 uniform float u_max_point;
@@ -21,8 +22,5 @@ void main()
     v_center = p;
     v_normal = r.n_k1.xyz;
     gl_Position = sl_view_projection * vec4(p, 1.0);
-    float z = pt_eye_distance(p);
-    // The disk's projected diameter plus a pixel each side, at least 3 px so
-    // the particle's own pixel is always covered.
-    gl_PointSize = clamp(2.0 * u_cone_radius * u_px_per_world / z + 2.0, 3.0, u_max_point);
+    gl_PointSize = pt_cone_point_size(p, u_cone_radius, u_max_point);
 }
