@@ -7,10 +7,14 @@
  * blended (ONE, ONE_MINUS_SRC_ALPHA) over the target, and it writes
  * max(mark, its own A > 0.5 depth): a mark in front of the sphere keeps its
  * pixel byte for byte, one behind it is covered as much as the volume's
- * opacity says. With MSAA the copy is a multisample-to-single-sample blit,
- * which resolves one sample per pixel (Mesa: sample 0), while the marcher
- * shades once per pixel for all samples: at the rim of a mark the volume
- * may be cut or drawn for the whole pixel (single-sample targets are exact).
+ * opacity says. With MSAA the marcher still shades once per pixel for all
+ * its samples, so the copy must pick one mark depth per pixel: a blit would
+ * resolve one sample (implementation-defined; Mesa: sample 0), drawing the
+ * volume over a mark in front of the sphere wherever that sample missed
+ * it. The resolve pass (particles_focus_resolve.frag.glsl) takes the
+ * nearest mark among the samples instead: a pixel holding any mark in front
+ * of the sphere stays byte-equal to the marks alone, at the price of no
+ * volume in the uncovered samples of such a rim pixel.
  */
 #include "particles_focus.h"
 
@@ -30,7 +34,7 @@ static void release_copy(pt_focus *f)
     if (f->fbo) glDeleteFramebuffers(1, &f->fbo);
     if (f->depth) glDeleteTextures(1, &f->depth);
     f->fbo = f->depth = 0;
-    f->width = f->height = 0;
+    f->width = f->height = f->msaa = 0;
 }
 
 void pt_focus_deinit(pt_focus *f)
@@ -38,6 +42,9 @@ void pt_focus_deinit(pt_focus *f)
     if (!f)
         return;
     release_copy(f);
+    if (f->resolve_program) glDeleteProgram(f->resolve_program);
+    if (f->vao) glDeleteVertexArrays(1, &f->vao);
+    f->resolve_program = f->vao = 0;
     if (f->ready) {
         sl_volume_marcher_deinit(&f->marcher);
         sl_volume_bricks_destroy(&f->bricks);
@@ -69,18 +76,32 @@ static sl_status ensure_ready(pt_focus *f, sl_err *err)
     return SL_OK;
 }
 
-static sl_status ensure_copy(pt_focus *f, int w, int h, sl_err *err)
+static sl_status ensure_copy(pt_focus *f, int w, int h, int msaa, sl_err *err)
 {
-    if (f->fbo && f->width == w && f->height == h)
+    if (msaa && !f->resolve_program) {
+        sl_status st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
+                                                               .fragment = "particles/particles_focus_resolve.frag.glsl",
+                                                               .label = "particles focus depth resolve"},
+                                            &f->resolve_program, err);
+        if (st != SL_OK)
+            return st;
+        glCreateVertexArrays(1, &f->vao);
+    }
+    if (f->fbo && f->width == w && f->height == h && f->msaa == msaa)
         return SL_OK;
     release_copy(f);
     glCreateTextures(GL_TEXTURE_2D, 1, &f->depth);
-    glTextureStorage2D(f->depth, 1, GL_DEPTH_COMPONENT32F, w, h);
+    glTextureStorage2D(f->depth, 1, msaa ? GL_R32F : GL_DEPTH_COMPONENT32F, w, h);
     glTextureParameteri(f->depth, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(f->depth, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glCreateFramebuffers(1, &f->fbo);
-    glNamedFramebufferTexture(f->fbo, GL_DEPTH_ATTACHMENT, f->depth, 0);
-    glNamedFramebufferDrawBuffer(f->fbo, GL_NONE);
+    if (msaa) {
+        glNamedFramebufferTexture(f->fbo, GL_COLOR_ATTACHMENT0, f->depth, 0);
+        glNamedFramebufferDrawBuffer(f->fbo, GL_COLOR_ATTACHMENT0);
+    } else {
+        glNamedFramebufferTexture(f->fbo, GL_DEPTH_ATTACHMENT, f->depth, 0);
+        glNamedFramebufferDrawBuffer(f->fbo, GL_NONE);
+    }
     glNamedFramebufferReadBuffer(f->fbo, GL_NONE);
     if (glCheckNamedFramebufferStatus(f->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         release_copy(f);
@@ -88,6 +109,7 @@ static sl_status ensure_copy(pt_focus *f, int w, int h, sl_err *err)
     }
     f->width = w;
     f->height = h;
+    f->msaa = msaa;
     return sl_gl_check_errors("particles: the focus depth copy", err);
 }
 
@@ -98,14 +120,31 @@ sl_status pt_focus_draw(pt_focus *f, const sl_view *view, const sl_params *param
     if (!(radius > 0.0))
         return SL_OK;
     sl_status st = ensure_ready(f, err);
+    int msaa = target->samples > 1;
     if (st == SL_OK)
-        st = ensure_copy(f, target->width, target->height, err);
+        st = ensure_copy(f, target->width, target->height, msaa, err);
     if (st != SL_OK) {
         sl_err_prefix(err, "particles: focus");
         return st;
     }
-    glBlitNamedFramebuffer(target->fbo, f->fbo, 0, 0, target->width, target->height, 0, 0, target->width,
-                           target->height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    if (msaa) {
+        /* The target's depth texture is read, not attached: no feedback. */
+        glBindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+        glViewport(0, 0, target->width, target->height);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        glUseProgram(f->resolve_program);
+        glUniform1i(glGetUniformLocation(f->resolve_program, "u_depth"), 0);
+        glUniform1i(glGetUniformLocation(f->resolve_program, "u_samples"), target->samples);
+        glBindTextureUnit(0, target->depth);
+        glBindVertexArray(f->vao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindVertexArray(0);
+        glBindTextureUnit(0, 0);
+    } else {
+        glBlitNamedFramebuffer(target->fbo, f->fbo, 0, 0, target->width, target->height, 0, 0, target->width,
+                               target->height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, target->fbo);
     glViewport(0, 0, view->width, view->height);
     float centre[3], light[3];

@@ -5,9 +5,9 @@
  * focus_step; outside it the marks. Particles inside the sphere are culled
  * by the cone and mark shaders themselves (pt_in_focus, particles_record.glsl;
  * u_focus from pt_frame). One frame, one depth: after every set's marks the
- * target's depth is copied into a texture (a blit; from an MSAA target it
- * resolves one sample per pixel), the marcher ends each ray there and writes
- * the nearer of mark and volume. Not here: the marks (the styles draw them).
+ * target's depth is copied into a texture (single-sample: a blit; MSAA: the
+ * nearest mark among each pixel's samples), the marcher ends each ray there
+ * and writes the nearer of mark and volume. Not here: the marks (the styles draw them).
  * Nothing is built before the first frame with a focus (bricks, marcher
  * programs, the depth copy), so prepares without one cost nothing.
  * Render thread only.
@@ -32,8 +32,10 @@ typedef struct pt_focus {
     int ready;                    /* bricks and marcher built (first focus frame) */
     sl_volume_bricks bricks;
     sl_volume_marcher marcher;
-    GLuint fbo, depth;            /* the depth copy (DEPTH_COMPONENT32F, target sized) */
-    int width, height;
+    GLuint fbo, depth;            /* the depth copy, target sized: DEPTH_COMPONENT32F
+                                     (single-sample) or R32F (MSAA resolve) */
+    int width, height, msaa;      /* what fbo/depth were made for */
+    GLuint resolve_program, vao;  /* MSAA only, made at the first MSAA focus frame */
 } pt_focus;
 
 /* Remembers what the marcher will read; no GL, cannot fail. */

@@ -18,7 +18,9 @@
  *   centre differ from it at N at least (default 1).
  * front: pixels with a mark (KD > 0) in front of the sphere (the ray misses
  *   it, or the mark is nearer than where the ray enters it) have C's RGB
- *   equal to K's exactly; N such pixels at least.
+ *   equal to K's exactly; N such pixels at least. Single-sample images only:
+ *   the depth map is always single-sample, and llvmpipe places MSAA point
+ *   sprites differently.
  * behind: pixels with a mark behind the volume's depth (0 < VD < KD) have
  *   C's RGB within M (default 1) of V's (V: the volume alone); N at least.
  * depth: CD is the nearer of KD and VD (relative E, default 1e-4; 0 where
@@ -260,7 +262,10 @@ static int check_front(const options *o)
             front++;
             front_in_disc += in_disc;
             int d = rgb_diff(c.rgba + 4 * n, k.rgba + 4 * n);
-            bad += d > 0;
+            if (d > 0 && bad++ == 0)
+                printf("first at (%d, %d): %d,%d,%d, the marks' %d,%d,%d; mark at %g, sphere entry %g\n", i, j,
+                       c.rgba[4 * n], c.rgba[4 * n + 1], c.rgba[4 * n + 2], k.rgba[4 * n], k.rgba[4 * n + 1],
+                       k.rgba[4 * n + 2], t, r.t_in);
             worst = d > worst ? d : worst;
         }
     printf("front: %ld mark pixels in front of the sphere (%ld over its projection), %ld differ (max %d)\n", front,
