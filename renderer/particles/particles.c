@@ -24,6 +24,7 @@
 #include "../gpu/sl_gpu.h"
 #include "../volume/sl_volume.h"
 #include "particles_cache.h"
+#include "particles_focus.h"
 #include "particles_frame.h"
 #include "particles_contours.h"
 #include "particles_hsr.h"
@@ -82,6 +83,18 @@ static const sl_param_def particles_params[] = {
      "length of each particle's contour segment, in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
     {"contour_width", SL_PARAM_FLOAT, 0.5, 16.0, {2.0}, NULL, "px", "width of the contour lines on screen",
      SL_INVALIDATE_FRAME},
+    {"focus_center", SL_PARAM_VEC3, -1e30, 1e30, {0.0, 0.0, 0.0}, NULL, "world",
+     "centre of the focus sphere, where the volume is ray marched instead of drawn as particles",
+     SL_INVALIDATE_FRAME},
+    {"focus_radius", SL_PARAM_FLOAT, 0.0, 1e30, {0.0}, NULL, "world",
+     "radius of the focus sphere: inside it the volume (volume_dvr's marcher), outside the particles (0: off)",
+     SL_INVALIDATE_FRAME},
+    {"focus_transfer_function", SL_PARAM_TRANSFER, 0, 0, {0, SL_TF_AUTO_OPACITY, 0}, NULL, "data",
+     "colour and opacity per data value inside the focus sphere (as volume_dvr's transfer_function; default "
+     "viridis with an opacity ramp from the histogram)", SL_INVALIDATE_FRAME},
+    {"focus_step", SL_PARAM_FLOAT, 0.01, 16.0, {0.5}, NULL, "voxel",
+     "sampling distance of the focus ray marcher in smallest voxel spacings (doubled on interactive frames)",
+     SL_INVALIDATE_FRAME},
     {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
     {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
     {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
@@ -102,6 +115,7 @@ typedef struct particles_state {
     pt_stipple stipple;
     pt_splat splat;
     pt_contours contours;
+    pt_focus focus;
     GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
@@ -121,6 +135,7 @@ static void particles_release(void *opaque)
     pt_stipple_deinit(&s->stipple);
     pt_splat_deinit(&s->splat);
     pt_contours_deinit(&s->contours);
+    pt_focus_deinit(&s->focus);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -195,6 +210,7 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         return sl_err_set(err, SL_ERR_NOMEM, "particles: out of memory");
     s->dataset = ds;
     sl_volume_geometry_init(ds, &s->geom);
+    pt_focus_init(&s->focus, &ds->volume, &s->volume, &s->geom);
     sl_status st = resolve_isovalues(&ds->volume, params, s->iso, &s->set_count, err);
     int built = 0;
     if (st != SL_OK)
@@ -327,6 +343,9 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
                 return st;
         }
     }
+    sl_status focus_st = pt_focus_draw(&s->focus, view, params, target, stats, err);
+    if (focus_st != SL_OK)
+        return focus_st;
     glDisable(GL_BLEND);
     glBindTextureUnit(0, 0);
     glBindVertexArray(0);
@@ -343,6 +362,7 @@ static size_t particles_gpu_bytes(const void *opaque)
     if (!s)
         return 0;
     return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_contours_bytes(&s->contours);
+    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_focus_bytes(&s->focus);
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)

@@ -25,6 +25,12 @@ void pt_frame_init(pt_frame *f, const sl_view *view, const sl_params *params, sl
     f->volume_offset[2] = (float)(volume_origin.z - view->origin.z);
     f->px_per_world = (float)(view->height / (2.0 * view->tan_half_fov));
     f->max_point = max_point;
+    float c[3];
+    sl_params_vec3(params, "focus_center", c);
+    f->focus[0] = (float)(c[0] - volume_origin.x);
+    f->focus[1] = (float)(c[1] - volume_origin.y);
+    f->focus[2] = (float)(c[2] - volume_origin.z);
+    f->focus[3] = (float)sl_params_float(params, "focus_radius");
 }
 
 void pt_frame_uniforms(GLuint program, const pt_frame *f)
@@ -32,4 +38,5 @@ void pt_frame_uniforms(GLuint program, const pt_frame *f)
     glUniform3fv(glGetUniformLocation(program, "u_volume_offset"), 1, f->volume_offset);
     glUniform1f(glGetUniformLocation(program, "u_px_per_world"), f->px_per_world);
     glUniform1f(glGetUniformLocation(program, "u_max_point"), f->max_point);
+    glUniform4fv(glGetUniformLocation(program, "u_focus"), 1, f->focus);
 }

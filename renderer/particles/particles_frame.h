@@ -24,6 +24,7 @@ typedef struct pt_frame {
     float volume_offset[3];   /* volume origin - view origin */
     float px_per_world;       /* view height / (2 tan(fov_y / 2)) */
     float max_point;          /* GL_POINT_SIZE_RANGE max */
+    float focus[4];           /* focus sphere: centre in local world, radius (0 = none) */
 } pt_frame;
 
 /* One set as its styles see it. */
@@ -38,7 +39,7 @@ typedef struct pt_set_view {
 
 void pt_frame_init(pt_frame *f, const sl_view *view, const sl_params *params, sl_vec3 volume_origin,
                    float max_point);
-/* u_volume_offset, u_px_per_world, u_max_point of `program` (in use). */
+/* u_volume_offset, u_px_per_world, u_max_point, u_focus of `program` (in use). */
 void pt_frame_uniforms(GLuint program, const pt_frame *f);
 
 #endif

@@ -7,6 +7,7 @@
 // n.l) with n facing the viewer: dark ink on a light background wants
 // 1 - d, light ink on a dark background wants d; contrast stretches it about
 // 1/2, brightness shifts it towards less ink on a brighter picture.
+// Particles inside the focus sphere draw nothing.
 #include "gpu/glsl/camera.glsl"
 #include "particles/particles_record.glsl"
 
@@ -33,7 +34,7 @@ void main()
     pt_record r = pt_rec[gl_VertexID];
     vec3 p = pt_view_position(r);
     vec4 clip = sl_view_projection * vec4(p, 1.0);
-    if (!(clip.w > 0.0)) {
+    if (!(clip.w > 0.0) || pt_in_focus(r.x.xyz)) {
         cull();
         return;
     }

@@ -13,6 +13,7 @@ layout(std430, binding = 1) readonly buffer pt_records { pt_record pt_rec[]; };
 
 uniform vec3 u_volume_offset;   // volume origin - view origin (positions relative to the view origin)
 uniform float u_px_per_world;   // window height / (2 tan(fov_y / 2)): pixels per world unit at eye distance 1
+uniform vec4 u_focus;           // focus sphere: xyz centre in local world, w radius (0 = no focus)
 
 vec3 pt_view_position(pt_record r)
 {
@@ -23,4 +24,12 @@ vec3 pt_view_position(pt_record r)
 float pt_eye_distance(vec3 p)
 {
     return max(dot(p - sl_eye.xyz, sl_forward.xyz), 1e-30);
+}
+
+// Inside the focus sphere (focus + context): such a particle casts no cone
+// and draws no mark, the volume is drawn there instead (particles_focus.h).
+bool pt_in_focus(vec3 local)
+{
+    vec3 v = local - u_focus.xyz;
+    return u_focus.w > 0.0 && dot(v, v) < u_focus.w * u_focus.w;
 }
