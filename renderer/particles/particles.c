@@ -23,6 +23,7 @@
 #include "../gpu/sl_gpu.h"
 #include "../volume/sl_volume.h"
 #include "particles_frame.h"
+#include "particles_hatch.h"
 #include "particles_hsr.h"
 #include "particles_stipple.h"
 #include "particles_system.h"
@@ -31,6 +32,7 @@
 
 static const char *const sort_names[] = {"radix", "bitonic", NULL};
 static const char *const lookup_names[] = {"prefix_sum", "binary_search", NULL};
+static const char *const hatch_mode_names[] = {"curvature", "fixed", NULL};
 
 static const sl_param_def particles_params[] = {
     {"isovalues", SL_PARAM_VALUES, -1e30, 1e30, {0}, NULL, "data",
@@ -67,6 +69,26 @@ static const sl_param_def particles_params[] = {
      SL_INVALIDATE_FRAME},
     {"stipple_contrast", SL_PARAM_FLOAT, 0.0, 8.0, {1.0}, NULL, "", "stretches the tone about its middle",
      SL_INVALIDATE_FRAME},
+    {"hatch", SL_PARAM_INT, 0, 15, {0}, NULL, "sets", "per set: draw hatch strokes (brightest no stroke, middle one, "
+     "darkest cross-hatched where cross_hatching is on)", SL_INVALIDATE_FRAME},
+    {"hatch_mode", SL_PARAM_ENUM, 0, 0, {0}, hatch_mode_names, "",
+     "stroke direction: the reliability-weighted smoothed main principal direction of the neighbours (hatch_direction "
+     "where unreliable) or hatch_direction projected into the tangent plane", SL_INVALIDATE_FRAME},
+    {"hatch_direction", SL_PARAM_VEC3, -1.0, 1.0, {0.0, 0.0, 1.0}, NULL, "world",
+     "fixed stroke direction, projected into each particle's tangent plane", SL_INVALIDATE_FRAME},
+    {"hatch_length", SL_PARAM_FLOAT, 0.2, 8.0, {2.0}, NULL, "nn",
+     "stroke length, in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
+    {"hatch_segments", SL_PARAM_INT, 1, 16, {6}, NULL, "",
+     "segments per stroke, each vertex moved back onto the surface (the paper's six)", SL_INVALIDATE_FRAME},
+    {"hatch_width", SL_PARAM_FLOAT, 0.5, 8.0, {1.0}, NULL, "px", "stroke width on screen", SL_INVALIDATE_FRAME},
+    {"cross_hatching", SL_PARAM_INT, 0, 15, {0}, NULL, "sets",
+     "per set: a second stroke at cross_angle where the tone is darkest", SL_INVALIDATE_FRAME},
+    {"cross_angle", SL_PARAM_FLOAT, 0.0, 180.0, {90.0}, NULL, "deg", "angle of the cross stroke to the main one",
+     SL_INVALIDATE_FRAME},
+    {"hatch_threshold", SL_PARAM_FLOAT, 0.0, 1.0, {0.7}, NULL, "",
+     "no stroke where the brightness (the diffuse term; 1 - it for light ink) is at least this", SL_INVALIDATE_FRAME},
+    {"cross_threshold", SL_PARAM_FLOAT, 0.0, 1.0, {0.35}, NULL, "",
+     "cross strokes where the brightness is below this", SL_INVALIDATE_FRAME},
     {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
     {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
     {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
@@ -85,6 +107,7 @@ typedef struct particles_state {
     pt_set sets[PT_MAX_SETS];
     pt_hsr hsr;
     pt_stipple stipple;
+    pt_hatch hatch;
     GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
@@ -102,6 +125,7 @@ static void particles_release(void *opaque)
     sl_volume_texture_destroy(&s->volume);
     pt_hsr_deinit(&s->hsr);
     pt_stipple_deinit(&s->stipple);
+    pt_hatch_deinit(&s->hatch);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -198,6 +222,8 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         field.dims[a] = ds->volume.dims[a];
         field.spacing[a] = ds->volume.spacing[a];
     }
+    if ((st = pt_hatch_init(&s->hatch, &field, err)) != SL_OK)
+        goto fail;
     double step = sl_params_float(params, "spacing");
     pt_system_desc desc = {.lattice_step = step,
                            .sigma = sl_params_float(params, "repulsion_radius") * step * s->geom.min_spacing,
@@ -236,6 +262,17 @@ static double luminance(const float c[3])
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
+/* The sets some style draws: the union of the style masks (a new style adds
+ * its mask's name). */
+static int style_mask(const sl_params *params)
+{
+    static const char *const masks[] = {"stipple", "hatch"};
+    int m = 0;
+    for (size_t k = 0; k < sizeof masks / sizeof masks[0]; k++)
+        m |= sl_params_int(params, masks[k]);
+    return m;
+}
+
 static sl_status particles_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                                   sl_render_stats *stats, sl_err *err)
 {
@@ -252,7 +289,7 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
     double drawn = 0.0;
     for (int k = 0; k < s->set_count; k++) {
         const pt_set *set = &s->sets[k];
-        int styles = stipple_mask;
+        int styles = style_mask(params);
         if (set->stats.alive == 0 || !(styles >> k & 1))
             continue;
         pt_set_view sv = {.set = set, .index = k};
@@ -273,6 +310,11 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
         }
         if (stipple_mask >> k & 1)
             drawn += pt_stipple_draw(&s->stipple, &frame, &sv, params);
+        if (sl_params_int(params, "hatch") >> k & 1) {
+            sl_status st = pt_hatch_draw(&s->hatch, &frame, &sv, s->iso[k], params, &drawn, err);
+            if (st != SL_OK)
+                return st;
+        }
     }
     glDisable(GL_BLEND);
     glBindTextureUnit(0, 0);
@@ -289,7 +331,7 @@ static size_t particles_gpu_bytes(const void *opaque)
     const particles_state *s = opaque;
     if (!s)
         return 0;
-    return s->gpu_bytes + pt_hsr_bytes(&s->hsr);
+    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_hatch_bytes(&s->hatch);
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)
