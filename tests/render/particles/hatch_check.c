@@ -13,6 +13,9 @@
  *     must follow the analytic main principal direction: the angle between
  *     the chord of its two vertices next to the particle, in the particle's
  *     tangent plane, and pref_torus_curvature's main direction.
+ *   hatch-check time --dataset JSON [--param ...] [--size WxH] [--frames N]
+ *     wall ms per frame (camera moves, no rebuild) and per frame with a
+ *     rebuild (hatch_length alternating), for the README; judges nothing.
  * Prints the measured values; exit 0 pass, 1 FAIL (named), 2 usage or setup.
  * Single thread (the render thread: it owns the GL context).
  */
@@ -96,11 +99,13 @@ static int set_param(sl_params *p, const char *spec, sl_err *err)
     return 0;
 }
 
+static int view_width = 256, view_height = 256;
+
 static sl_status make_view(const sl_dataset *ds, double azimuth, sl_view *view, sl_err *err)
 {
     memset(view, 0, sizeof *view);
-    view->width = 256;
-    view->height = 256;
+    view->width = view_width;
+    view->height = view_height;
     const float bg[4] = {0.1f, 0.1f, 0.12f, 1.0f};
     memcpy(view->background, bg, sizeof bg);
     view->origin = ds->origin;
@@ -171,11 +176,13 @@ static int direction_check(const capture *c, const sl_dataset *ds, double eps, d
 
 int main(int argc, char **argv)
 {
-    if (argc < 2 || (strcmp(argv[1], "rebuild") != 0 && strcmp(argv[1], "direction") != 0)) {
-        fprintf(stderr, "usage: hatch-check rebuild|direction --dataset JSON [--param name=value]... ...\n");
+    if (argc < 2 ||
+        (strcmp(argv[1], "rebuild") != 0 && strcmp(argv[1], "direction") != 0 && strcmp(argv[1], "time") != 0)) {
+        fprintf(stderr, "usage: hatch-check rebuild|direction|time --dataset JSON [--param name=value]... ...\n");
         return 2;
     }
-    int direction = strcmp(argv[1], "direction") == 0;
+    int direction = strcmp(argv[1], "direction") == 0, timing = strcmp(argv[1], "time") == 0;
+    int frames = 5;
     const char *dataset = NULL, *params_in[MAX_ARGS], *steps[MAX_ARGS];
     int np = 0, ns = 0;
     double major = 0.55, minor = 0.25, min_rho = 0.9, max_mean = 1e30, max_p90 = 1e30;
@@ -194,6 +201,13 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--min-reliability")) min_rho = atof(v);
         else if (!strcmp(a, "--max-mean-deg")) max_mean = atof(v);
         else if (!strcmp(a, "--max-p90-deg")) max_p90 = atof(v);
+        else if (!strcmp(a, "--frames")) frames = atoi(v);
+        else if (!strcmp(a, "--size")) {
+            if (sscanf(v, "%dx%d", &view_width, &view_height) != 2 || view_width < 1 || view_height < 1) {
+                fprintf(stderr, "hatch-check: bad --size %s (WxH)\n", v);
+                return 2;
+            }
+        }
         else {
             fprintf(stderr, "hatch-check: unknown option %s\n", a);
             return 2;
@@ -236,6 +250,32 @@ int main(int argc, char **argv)
     if (direction) {
         rc = direction_check(&cap, dsv, sl_params_float(&params, "flat_curvature") / min_spacing, major, minor,
                              min_rho, max_mean, max_p90);
+        goto done;
+    }
+    if (timing) {
+        double cam = 0.0, reb = 0.0;
+        for (int k = 0; k < frames; k++) {
+            azimuth += 10.0;
+            if (make_view(dsv, azimuth, &view, &err) != SL_OK || sl_pipeline_render(pipe, &view, 1, &fs, &err) != SL_OK)
+                break;
+            cam += fs.wall_ms;
+        }
+        double length = sl_params_float(&params, "hatch_length");
+        for (int k = 0; k < frames; k++) {
+            if (sl_params_set_numbers(&params, "hatch_length", (double[]){length * (k % 2 ? 1.0 : 1.1)}, 1, &err) !=
+                    SL_OK ||
+                sl_pipeline_set_technique(pipe, t, &params, &err) != SL_OK ||
+                sl_pipeline_render(pipe, &view, 1, &fs, &err) != SL_OK)
+                break;
+            reb += fs.wall_ms;
+        }
+        if (err.message[0]) {
+            fprintf(stderr, "hatch-check: %s\n", err.message);
+            goto done;
+        }
+        printf("%dx%d: %.1f ms per frame (camera moves), %.1f ms per frame with a rebuild (%lu builds)\n", view_width,
+               view_height, cam / frames, reb / frames, pt_debug_hatch_builds());
+        rc = 0;
         goto done;
     }
     rc = 0;
