@@ -222,8 +222,7 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         field.dims[a] = ds->volume.dims[a];
         field.spacing[a] = ds->volume.spacing[a];
     }
-    if ((st = pt_hatch_init(&s->hatch, &field, err)) != SL_OK)
-        goto fail;
+    pt_hatch_init(&s->hatch, &field);
     double step = sl_params_float(params, "spacing");
     pt_system_desc desc = {.lattice_step = step,
                            .sigma = sl_params_float(params, "repulsion_radius") * step * s->geom.min_spacing,

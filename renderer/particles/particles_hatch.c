@@ -33,19 +33,25 @@ unsigned long pt_debug_hatch_builds(void)
     return atomic_load(&hatch_builds);
 }
 
-sl_status pt_hatch_init(pt_hatch *h, const pt_field *field, sl_err *err)
+void pt_hatch_init(pt_hatch *h, const pt_field *field)
 {
     memset(h, 0, sizeof *h);
     h->field = *field;
-    sl_status st = sl_gl_program_create(&(sl_program_desc){.compute = "particles/particles_hatch.comp.glsl",
-                                                           .label = "particles hatch strokes"},
-                                        &h->build_program, err);
-    if (st != SL_OK)
-        return st;
-    return sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_stroke.vert.glsl",
-                                                   .fragment = "particles/particles_stroke.frag.glsl",
-                                                   .label = "particles hatches"},
-                                &h->draw_program, err);
+}
+
+static sl_status ensure_programs(pt_hatch *h, sl_err *err)
+{
+    sl_status st = SL_OK;
+    if (!h->build_program)
+        st = sl_gl_program_create(&(sl_program_desc){.compute = "particles/particles_hatch.comp.glsl",
+                                                     .label = "particles hatch strokes"},
+                                  &h->build_program, err);
+    if (st == SL_OK && !h->draw_program)
+        st = sl_gl_program_create(&(sl_program_desc){.vertex = "particles/particles_stroke.vert.glsl",
+                                                     .fragment = "particles/particles_stroke.frag.glsl",
+                                                     .label = "particles hatches"},
+                                  &h->draw_program, err);
+    return st;
 }
 
 static void release_cache(pt_hatch_cache *c)
@@ -169,10 +175,13 @@ sl_status pt_hatch_draw(pt_hatch *h, const pt_frame *f, const pt_set_view *sv, d
 {
     if (sv->index < 0 || sv->index >= PT_HATCH_SETS)
         return SL_OK;
+    sl_status st = ensure_programs(h, err);
+    if (st != SL_OK)
+        return st;
     pt_hatch_cache *c = &h->cache[sv->index];
     pt_hatch_key key = make_key(h, sv, params);
     if (!c->strokes || c->particles != sv->set->stats.alive || memcmp(&key, &c->key, sizeof key) != 0) {
-        sl_status st = build(h, c, sv, &key, iso, err);
+        st = build(h, c, sv, &key, iso, err);
         if (st != SL_OK)
             return st;
     }

@@ -48,9 +48,10 @@ typedef struct pt_hatch {
     pt_hatch_cache cache[PT_HATCH_SETS];
 } pt_hatch;
 
-/* Compiles the two programs; field is what the sets live on (its texture is
- * borrowed and must outlive h). SL_ERR_GPU with the info log. */
-sl_status pt_hatch_init(pt_hatch *h, const pt_field *field, sl_err *err);
+/* field is what the sets live on (its texture is borrowed and must outlive
+ * h). Compiles nothing: the two programs are made at the first draw, so a
+ * prepare without hatching does not pay for them. */
+void pt_hatch_init(pt_hatch *h, const pt_field *field);
 void pt_hatch_deinit(pt_hatch *h); /* zeroed is fine */
 /* Bytes of the stroke caches. */
 size_t pt_hatch_bytes(const pt_hatch *h);
@@ -58,8 +59,9 @@ size_t pt_hatch_bytes(const pt_hatch *h);
 /* Draws the hatches of one set (records at SSBO binding 1) into the bound
  * target, building its strokes first when its key changed (iso: the set's
  * isovalue, for the reprojection onto the surface). Adds the stroke
- * segments issued to *drawn. SL_ERR_GPU when the build fails (the cache is
- * then empty and nothing is drawn). */
+ * segments issued to *drawn. SL_ERR_GPU when a program does not compile
+ * (with the info log) or the build fails (the cache is then empty and
+ * nothing is drawn). */
 sl_status pt_hatch_draw(pt_hatch *h, const pt_frame *f, const pt_set_view *sv, double iso, const sl_params *params,
                         double *drawn, sl_err *err);
 
