@@ -27,6 +27,7 @@
 #include "particles_focus.h"
 #include "particles_frame.h"
 #include "particles_contours.h"
+#include "particles_hatch.h"
 #include "particles_hsr.h"
 #include "particles_splat.h"
 #include "particles_stipple.h"
@@ -36,6 +37,7 @@
 
 static const char *const sort_names[] = {"radix", "bitonic", NULL};
 static const char *const lookup_names[] = {"prefix_sum", "binary_search", NULL};
+static const char *const hatch_mode_names[] = {"curvature", "fixed", NULL};
 
 static const sl_param_def particles_params[] = {
     {"isovalues", SL_PARAM_VALUES, -1e30, 1e30, {0}, NULL, "data",
@@ -95,6 +97,26 @@ static const sl_param_def particles_params[] = {
     {"focus_step", SL_PARAM_FLOAT, 0.01, 16.0, {0.5}, NULL, "voxel",
      "sampling distance of the focus ray marcher in smallest voxel spacings (doubled on interactive frames)",
      SL_INVALIDATE_FRAME},
+    {"hatch", SL_PARAM_INT, 0, 15, {0}, NULL, "sets", "per set: draw hatch strokes (brightest no stroke, middle one, "
+     "darkest cross-hatched where cross_hatching is on)", SL_INVALIDATE_FRAME},
+    {"hatch_mode", SL_PARAM_ENUM, 0, 0, {0}, hatch_mode_names, "",
+     "stroke direction: the reliability-weighted smoothed main principal direction of the neighbours (hatch_direction "
+     "where unreliable) or hatch_direction projected into the tangent plane", SL_INVALIDATE_FRAME},
+    {"hatch_direction", SL_PARAM_VEC3, -1.0, 1.0, {0.0, 0.0, 1.0}, NULL, "world",
+     "fixed stroke direction, projected into each particle's tangent plane", SL_INVALIDATE_FRAME},
+    {"hatch_length", SL_PARAM_FLOAT, 0.2, 8.0, {2.0}, NULL, "nn",
+     "stroke length, in mean nearest-neighbour distances", SL_INVALIDATE_FRAME},
+    {"hatch_segments", SL_PARAM_INT, 1, 16, {6}, NULL, "",
+     "segments per stroke, each vertex moved back onto the surface (the paper's six)", SL_INVALIDATE_FRAME},
+    {"hatch_width", SL_PARAM_FLOAT, 0.5, 8.0, {1.0}, NULL, "px", "stroke width on screen", SL_INVALIDATE_FRAME},
+    {"cross_hatching", SL_PARAM_INT, 0, 15, {0}, NULL, "sets",
+     "per set: a second stroke at cross_angle where the tone is darkest", SL_INVALIDATE_FRAME},
+    {"cross_angle", SL_PARAM_FLOAT, 0.0, 180.0, {90.0}, NULL, "deg", "angle of the cross stroke to the main one",
+     SL_INVALIDATE_FRAME},
+    {"hatch_threshold", SL_PARAM_FLOAT, 0.0, 1.0, {0.7}, NULL, "",
+     "no stroke where the brightness (the diffuse term; 1 - it for light ink) is at least this", SL_INVALIDATE_FRAME},
+    {"cross_threshold", SL_PARAM_FLOAT, 0.0, 1.0, {0.35}, NULL, "",
+     "cross strokes where the brightness is below this", SL_INVALIDATE_FRAME},
     {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
     {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
     {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
@@ -116,6 +138,7 @@ typedef struct particles_state {
     pt_splat splat;
     pt_contours contours;
     pt_focus focus;
+    pt_hatch hatch;
     GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
@@ -136,6 +159,7 @@ static void particles_release(void *opaque)
     pt_splat_deinit(&s->splat);
     pt_contours_deinit(&s->contours);
     pt_focus_deinit(&s->focus);
+    pt_hatch_deinit(&s->hatch);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -234,6 +258,7 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         field.dims[a] = ds->volume.dims[a];
         field.spacing[a] = ds->volume.spacing[a];
     }
+    pt_hatch_init(&s->hatch, &field);
     double step = sl_params_float(params, "spacing");
     pt_system_desc desc = {.lattice_step = step,
                            .sigma = sl_params_float(params, "repulsion_radius") * step * s->geom.min_spacing,
@@ -286,7 +311,7 @@ static double luminance(const float c[3])
 
 /* The per-set style switches (INT "sets" masks): a set draws when any of
  * its bits is on. A new style adds its switch here. */
-static const char *const style_masks[] = {"stipple", "splat", "contours", NULL};
+static const char *const style_masks[] = {"stipple", "splat", "hatch", "contours", NULL};
 
 static int any_style_mask(const sl_params *params)
 {
@@ -335,6 +360,11 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
             drawn += pt_splat_draw(&s->splat, &frame, &sv, cone_radius);
         if (stipple_mask >> k & 1)
             drawn += pt_stipple_draw(&s->stipple, &frame, &sv, params);
+        if (sl_params_int(params, "hatch") >> k & 1) {
+            sl_status st = pt_hatch_draw(&s->hatch, &frame, &sv, s->iso[k], params, &drawn, err);
+            if (st != SL_OK)
+                return st;
+        }
         if (sl_params_int(params, "contours") >> k & 1) {
             double sigma = sl_params_float(params, "repulsion_radius") * sl_params_float(params, "spacing") *
                            s->geom.min_spacing;
@@ -361,8 +391,8 @@ static size_t particles_gpu_bytes(const void *opaque)
     const particles_state *s = opaque;
     if (!s)
         return 0;
-    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_contours_bytes(&s->contours);
-    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_focus_bytes(&s->focus);
+    return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_contours_bytes(&s->contours) + pt_focus_bytes(&s->focus) +
+           pt_hatch_bytes(&s->hatch);
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)
