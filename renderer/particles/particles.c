@@ -9,7 +9,9 @@
  * radius, the stopping rule, sort, look-up, the particle cap) change the
  * particles, so a camera move or a style change never recomputes them.
  * render draws per set: hidden-surface removal by cone splatting into an id
- * target (Algorithm 3), then the stipples that pass it. export writes every
+ * target (Algorithm 3), then each style the set has on (splats, stipples,
+ * hatches, contours; each in its own file), then the focus region's volume
+ * (particles_focus.h). export writes every
  * alive particle as CSV (set,x,y,z,nx,ny,nz,k1,k2,reliability, world units).
  * Render thread only.
  */
@@ -446,8 +448,8 @@ static sl_status particles_export(void *opaque, const sl_params *params, const c
 
 const sl_technique sl_particles_technique = {
     .name = "particles",
-    .description = "illustrative isosurface particles: stippling with hidden-surface removal "
-                   "(van Pelt et al., GPU-based particle systems, 2010)",
+    .description = "illustrative isosurface particles: stipples, splats, curvature hatching, contours, "
+                   "focus + context (van Pelt et al., GPU-based particle systems, 2010)",
     .dataset_kinds = SL_DATASET_VOLUME,
     .params = particles_params,
     .param_count = (int)(sizeof particles_params / sizeof particles_params[0]),

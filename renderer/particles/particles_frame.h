@@ -3,8 +3,10 @@
  *
  * A frame draws the sets one after another; per set: hidden-surface removal
  * (particles_hsr.h) fills an id target, then each style the set has on
- * (stipples, ...) draws from the set's records into the bound target with
- * depth test GREATER, depth writes on and premultiplied blending. A style
+ * (splats, stipples, hatches, contours) draws from the set's records into
+ * the bound target with depth test GREATER and premultiplied blending,
+ * depth writes on (contours test depth but do not write it: overlapping
+ * segments would cut each other's anti-aliased edges). A style
  * reads the set's records at SSBO binding 1 (bound by the caller), the
  * frame's camera UBO at binding 0 and, with `hsr`, the id texture.
  * Render thread only.
