@@ -8,13 +8,16 @@
 // (colormaps too); vec3 with unit "rgb" -> a native colour input, any other
 // vec3 (directions, clip corners) -> three number fields clamped to
 // [min, max]; attribute -> select of the dataset's attribute names ("none" =
-// -1 when min is -1); transfer_function -> the editor of tf_editor.js.
+// -1 when min is -1); transfer_function -> the editor of tf_editor.js;
+// transfer_2d -> the editor of tf2d_editor.js, its preview over the first
+// "rgb" vec3 of the schema (particles: set 0's ink).
 // Descriptions become tooltips; sliders and number fields also show their
 // range and unit ("0 … 1000 world"). Knows no technique or parameter by
 // name: the schema's type, range and unit alone pick the control.
 
 import { TransferFunctionEditor, rgbToHex, hexToRgb } from './tf_editor.js';
 import { throttle } from './throttle.js';
+import { Tf2dEditor } from './tf2d_editor.js';
 
 // A schema range wider than this is typed, not slid.
 export const WIDE_RANGE = 1e6;
@@ -99,10 +102,11 @@ export class ParamControls {
     this.schemaKey = key;
     this.form.replaceChildren();
     this.inputs.clear();
+    this.inkName = null;
     this.context = context;
     for (const def of schema) {
       // A label forwards clicks to its first input: not for the editor's canvas.
-      const row = document.createElement(def.type === 'transfer_function' ? 'div' : 'label');
+      const row = document.createElement(def.type === 'transfer_function' || def.type === 'transfer_2d' ? 'div' : 'label');
       row.className = 'param';
       row.title = def.description || '';
       const name = document.createElement('span');
@@ -201,6 +205,12 @@ export class ParamControls {
         const ed = new TransferFunctionEditor(row, def, (v) => this.onChange(def.name, v), this.context);
         row.classList.add('tf');
         entry = { def, set: (v) => ed.set(v), editor: ed };
+      } else if (def.type === 'transfer_2d') {
+        const ink = schema.find((d) => d.type === 'vec3' && d.unit === 'rgb');
+        this.inkName = ink ? ink.name : null;
+        const ed = new Tf2dEditor(row, def, (v) => this.onChange(def.name, v), ink ? ink.default : undefined);
+        row.classList.add('tf');
+        entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'vec3') {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
@@ -234,6 +244,8 @@ export class ParamControls {
       const e = this.inputs.get(name);
       if (e && document.activeElement?.name !== name) e.set(v);
     }
+    const ink = this.inkName && values ? values[this.inkName] : undefined;
+    if (ink) for (const e of this.inputs.values()) if (e.editor && e.editor.setInk) e.editor.setInk(ink);
   }
 
   setEnabled(on) {
