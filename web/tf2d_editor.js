@@ -5,8 +5,8 @@
 // k2 > k1 shaded and Kindlmann's regions labelled faintly. Behind the widgets
 // a preview of the composite over the ink (tf2dColour: the rule the renderer
 // bakes, at the same 64 x 64 texel centres). Each widget is a circle: drag
-// its centre (or inside it) to move it, drag the rim handle to change its
-// radius; a colour input and an alpha slider edit the selected one;
+// its centre (or inside it) to move it, drag the rim handle (right of the
+// centre, or left when that is off the square) to change its radius; a colour input and an alpha slider edit the selected one;
 // double-click adds one (radius 0.15 range, grey, alpha 1), Delete removes
 // the selected one (one always stays); a number field sets the range; the
 // presets are the schema's default ("ridges light, valleys dark") and "none"
@@ -85,10 +85,13 @@ export class Tf2dEditor {
     this.rangeField.title = `half width of the square, ${def.unit || ''}`;
     this.info = document.createElement('small');
     this.info.className = 'range';
+    const presets = document.createElement('div');
+    presets.className = 'tf-tools';
+    presets.append(this.preset);
     const tools = document.createElement('div');
     tools.className = 'tf-tools';
-    tools.append(this.preset, this.color, this.alpha, this.rangeField);
-    box.append(this.canvas, tools, this.info);
+    tools.append(this.color, this.alpha, this.rangeField);
+    box.append(this.canvas, presets, tools, this.info);
     row.append(box);
 
     this.preset.addEventListener('change', () => this.applyPreset(this.preset.value));
@@ -176,8 +179,9 @@ export class Tf2dEditor {
     const b = this.canvas.getBoundingClientRect();
     return { x: (e.clientX - b.left) * (W / b.width), y: (e.clientY - b.top) * (H / b.height) };
   }
+  // The rim handle: right of the centre, or left when the right one is off the square.
   rimOf(w) {
-    return this.px(w[0] + w[2], w[1]);
+    return this.px(w[0] + w[2] <= this.range ? w[0] + w[2] : w[0] - w[2], w[1]);
   }
 
   // { i, part: 'rim' | 'centre' } of the widget under pos, the selected one
