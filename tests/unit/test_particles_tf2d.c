@@ -5,12 +5,15 @@
  * half k2 > k1 equals the diagonal; scaling range, centres and radii by 2
  * gives the same table. Then the five fixed points the browser test checks
  * the page's JS rule at (web/tf2d_editor.js, tests/browser/test_browser.cjs:
- * the values below are the ones it hard-codes). No GL.
+ * the values below are the ones it hard-codes). Last, with GL (llvmpipe is
+ * fine): pt_tf2d bakes a set's table only when it is on and its function or
+ * ink changed, and the texture holds the CPU bake byte for byte.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gpu/sl_gpu.h"
 #include "particles/particles_tf2d.h"
 #include "sl_test.h"
 
@@ -56,6 +59,43 @@ static const double js_expect[5][3] = {
     {0.508428272, 0.412202012, 0.483200028}, /* (0.0703125, -0.0234375) */
     {0.500000000, 0.500000000, 0.500000000}, /* (0.4453125, -0.4609375): outside every widget */
 };
+
+static void test_textures(void)
+{
+    sl_err err = {0};
+    sl_gpu *gpu = NULL;
+    if (sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &gpu, &err) != SL_OK) {
+        SL_CHECK_MSG(0, "sl_gpu_create: %s", err.message);
+        return;
+    }
+    pt_tf2d t;
+    SL_CHECK(pt_tf2d_init(&t, &err) == SL_OK);
+    sl_transfer_function_2d def;
+    sl_transfer_function_2d_preset(SL_TF2D_PRESET_RIDGES_VALLEYS, &def);
+    float ink[3] = {0.95f, 0.95f, 0.9f};
+    pt_curvature_lookup c = pt_tf2d_lookup(&t, 0, 0, &def, ink, 0.5);
+    SL_CHECK(!c.on && c.table == 0 && t.bakes == 0); /* off: no bake */
+    c = pt_tf2d_lookup(&t, 0, 1, &def, ink, 0.5);
+    SL_CHECK(c.on && c.table == t.tex[0] && c.range == 0.5f && c.min_spacing == 0.5f && t.bakes == 1);
+    pt_tf2d_lookup(&t, 0, 1, &def, ink, 0.25); /* same function and ink: no bake */
+    SL_CHECK(t.bakes == 1);
+    pt_tf2d_lookup(&t, 1, 1, &def, ink, 0.5);  /* another set: its own table */
+    SL_CHECK(t.bakes == 2);
+    ink[1] = 0.5f;
+    pt_tf2d_lookup(&t, 0, 1, &def, ink, 0.5);  /* the ink changed */
+    SL_CHECK(t.bakes == 3);
+    def.widget[1][6] = 0.5;
+    c = pt_tf2d_lookup(&t, 0, 1, &def, ink, 0.5); /* the function changed */
+    SL_CHECK(t.bakes == 4);
+    pt_tf2d_bake(&def, ink, table);
+    memset(other, 0, sizeof other);
+    glGetTextureImage(c.table, 0, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)sizeof other, other);
+    SL_CHECK_MSG(memcmp(table, other, sizeof table) == 0, "the texture of set 0 differs from the CPU bake");
+    SL_CHECK(sl_gl_check_errors("tf2d textures", &err) == SL_OK);
+    pt_tf2d_deinit(&t);
+    pt_tf2d_deinit(&t); /* twice is fine */
+    sl_gpu_destroy(gpu);
+}
 
 int main(int argc, char **argv)
 {
@@ -144,5 +184,6 @@ int main(int argc, char **argv)
             SL_CHECK_NEAR(c[q], js_expect[p][q], 1e-8);
         SL_CHECK(same_rgb(texel(table, js_texel[p][0], js_texel[p][1]), c[0], c[1], c[2]));
     }
+    test_textures();
     SL_TEST_END();
 }
