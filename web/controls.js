@@ -12,13 +12,15 @@
 // int with unit "sets" (a bit mask, bit k = set k) -> check boxes "set 0" …
 // "set 3"; values (0 … max_count numbers, [] = auto) -> a text field of
 // comma-separated numbers, checked against the schema range before it is
-// sent; transfer_2d -> a JSON text field with a one-line summary (shape
-// checked here, values by the server). Descriptions become tooltips; sliders and number fields also show their
+// sent; transfer_2d -> the editor of tf2d_editor.js, its preview over the
+// first "rgb" vec3 of the schema (particles: set 0's ink).
+// Descriptions become tooltips; sliders and number fields also show their
 // range and unit ("0 … 1000 world"). Knows no technique or parameter by
 // name: the schema's type, range and unit alone pick the control.
 
 import { TransferFunctionEditor, rgbToHex, hexToRgb } from './tf_editor.js';
 import { throttle } from './throttle.js';
+import { Tf2dEditor } from './tf2d_editor.js';
 
 // A schema range wider than this is typed, not slid.
 export const WIDE_RANGE = 1e6;
@@ -71,24 +73,6 @@ export function parseValueList(text, def) {
   }
   return { values };
 }
-
-// Text of a 'transfer_2d' field -> { value } or { error }: the JSON form
-// {"range": r, "widgets": [[k1, k2, radius, r, g, b, a], ...]}, shape only.
-export function parseTransfer2d(text, def) {
-  let v;
-  try { v = JSON.parse(text); } catch (e) { return { error: 'not JSON' }; }
-  const most = def.max_widgets || 16;
-  if (!v || typeof v !== 'object' || Array.isArray(v) || typeof v.range !== 'number' || !Array.isArray(v.widgets)) {
-    return { error: 'expected {"range": r, "widgets": [[k1, k2, radius, r, g, b, a], ...]}' };
-  }
-  if (v.widgets.length < 1 || v.widgets.length > most) return { error: `1 to ${most} widgets, got ${v.widgets.length}` };
-  const bad = v.widgets.findIndex((w) => !Array.isArray(w) || w.length !== 7 || w.some((x) => typeof x !== 'number'));
-  if (bad >= 0) return { error: `widget ${bad}: expected 7 numbers [k1, k2, radius, r, g, b, a]` };
-  return { value: v };
-}
-
-const transfer2dSummary = (v) => (v && Array.isArray(v.widgets)
-  ? `${v.widgets.length} widget${v.widgets.length === 1 ? '' : 's'} over ±${fmt(v.range)}` : '');
 
 // The dataset's value range within the schema's, when the dataset is known and not constant.
 function dataRange(context, def) {
@@ -144,11 +128,13 @@ export class ParamControls {
     this.schemaKey = key;
     this.form.replaceChildren();
     this.inputs.clear();
+    this.inkName = null;
     this.context = context;
     for (const def of schema) {
-      // A label forwards clicks to its first input: not for the editor's
-      // canvas, nor for a group of check boxes (each has its own label).
-      const grouped = def.type === 'transfer_function' || (def.type === 'int' && def.unit === 'sets');
+      // A label forwards clicks to its first input: not for the editors'
+      // canvases, nor for a group of check boxes (each has its own label).
+      const grouped = def.type === 'transfer_function' || def.type === 'transfer_2d' ||
+        (def.type === 'int' && def.unit === 'sets');
       const row = document.createElement(grouped ? 'div' : 'label');
       row.className = 'param';
       row.title = def.description || '';
@@ -203,27 +189,6 @@ export class ParamControls {
         });
         row.append(f, range);
         entry = { def, set: (v) => { f.value = Array.isArray(v) ? v.join(', ') : ''; mark(null); } };
-      } else if (def.type === 'transfer_2d') {
-        // For now the JSON form; a 2D editor may replace it.
-        const f = document.createElement('textarea');
-        f.name = def.name;
-        f.className = 'json';
-        f.rows = 2;
-        f.spellcheck = false;
-        const summary = document.createElement('small');
-        summary.className = 'range';
-        const mark = (error, v) => {
-          f.setCustomValidity(error || '');
-          f.classList.toggle('invalid', !!error);
-          summary.textContent = error ? `not sent: ${error}` : transfer2dSummary(v);
-        };
-        f.addEventListener('change', () => {
-          const r = parseTransfer2d(f.value, def);
-          mark(r.error, r.value);
-          if (!r.error) this.onChange(def.name, r.value);
-        });
-        row.append(f, summary);
-        entry = { def, set: (v) => { f.value = JSON.stringify(v); mark(null, v); } };
       } else if (def.type === 'attribute') {
         entry = { def, set: attributeSelect(row, def, attributes, (v) => this.onChange(def.name, v)) };
       } else if (def.type === 'float' && def.max - def.min > WIDE_RANGE && def.unit === 'data' &&
@@ -315,6 +280,12 @@ export class ParamControls {
         const ed = new TransferFunctionEditor(row, def, (v) => this.onChange(def.name, v), this.context);
         row.classList.add('tf');
         entry = { def, set: (v) => ed.set(v), editor: ed };
+      } else if (def.type === 'transfer_2d') {
+        const ink = schema.find((d) => d.type === 'vec3' && d.unit === 'rgb');
+        this.inkName = ink ? ink.name : null;
+        const ed = new Tf2dEditor(row, def, (v) => this.onChange(def.name, v), ink ? ink.default : undefined);
+        row.classList.add('tf');
+        entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'vec3') {
         const fields = [0, 1, 2].map(() => {
           const f = document.createElement('input');
@@ -348,6 +319,8 @@ export class ParamControls {
       const e = this.inputs.get(name);
       if (e && document.activeElement?.name !== name) e.set(v);
     }
+    const ink = this.inkName && values ? values[this.inkName] : undefined;
+    if (ink) for (const e of this.inputs.values()) if (e.editor && e.editor.setInk) e.editor.setInk(ink);
   }
 
   setEnabled(on) {

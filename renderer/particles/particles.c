@@ -34,6 +34,7 @@
 #include "particles_splat.h"
 #include "particles_stipple.h"
 #include "particles_system.h"
+#include "particles_tf2d.h"
 
 #define PT_MAX_SETS SL_PARAM_VALUES_MAX
 
@@ -119,6 +120,11 @@ static const sl_param_def particles_params[] = {
      "no stroke where the brightness (the diffuse term; 1 - it for light ink) is at least this", SL_INVALIDATE_FRAME},
     {"cross_threshold", SL_PARAM_FLOAT, 0.0, 1.0, {0.35}, NULL, "",
      "cross strokes where the brightness is below this", SL_INVALIDATE_FRAME},
+    {"curvature_coloring", SL_PARAM_INT, 0, 15, {0}, NULL, "sets",
+     "per set: colour the marks by the 2D curvature transfer function curvature_tf", SL_INVALIDATE_FRAME},
+    {"curvature_tf", SL_PARAM_TRANSFER_2D, 0, 0, {SL_TF2D_PRESET_RIDGES_VALLEYS}, NULL, "1/voxel",
+     "colour over the principal curvatures (k1, k2) per voxel, round widgets composited in order over the set's ink",
+     SL_INVALIDATE_FRAME},
     {"set0_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.95, 0.9}, NULL, "rgb", "ink of set 0", SL_INVALIDATE_FRAME},
     {"set1_color", SL_PARAM_VEC3, 0.0, 1.0, {0.95, 0.7, 0.45}, NULL, "rgb", "ink of set 1", SL_INVALIDATE_FRAME},
     {"set2_color", SL_PARAM_VEC3, 0.0, 1.0, {0.55, 0.8, 1.0}, NULL, "rgb", "ink of set 2", SL_INVALIDATE_FRAME},
@@ -141,6 +147,7 @@ typedef struct particles_state {
     pt_contours contours;
     pt_focus focus;
     pt_hatch hatch;
+    pt_tf2d tf2d;
     GLuint vao, camera_ubo;
     float max_point;                   /* GL_POINT_SIZE_RANGE max */
     size_t gpu_bytes;
@@ -162,6 +169,7 @@ static void particles_release(void *opaque)
     pt_contours_deinit(&s->contours);
     pt_focus_deinit(&s->focus);
     pt_hatch_deinit(&s->hatch);
+    pt_tf2d_deinit(&s->tf2d);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     free(s);
@@ -248,7 +256,8 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     s->prep.upload_ms = sl_clock_ms() - t_upload;
     if ((st = pt_system_create(&s->system, err)) != SL_OK || (st = pt_hsr_init(&s->hsr, err)) != SL_OK ||
         (st = pt_stipple_init(&s->stipple, err)) != SL_OK || (st = pt_splat_init(&s->splat, err)) != SL_OK ||
-        (st = pt_contours_init(&s->contours, err)) != SL_OK)
+        (st = pt_contours_init(&s->contours, err)) != SL_OK ||
+        (st = pt_tf2d_init(&s->tf2d, err)) != SL_OK)
         goto fail;
     pt_field field = {.texture = s->volume.tex,
                       .value_scale = s->volume.value_scale,
@@ -347,6 +356,8 @@ static sl_status particles_render(void *opaque, const sl_view *view, const sl_pa
         snprintf(name, sizeof name, "set%d_color", k);
         sl_params_vec3(params, name, sv.ink);
         sv.ink_dark = luminance(sv.ink) < luminance(view->background);
+        sv.curvature = pt_tf2d_lookup(&s->tf2d, k, sl_params_int(params, "curvature_coloring") >> k & 1,
+                                      sl_params_transfer_2d(params, "curvature_tf"), sv.ink, s->geom.min_spacing);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, set->records);
         double cone_radius = sl_params_float(params, "cone_radius") * set->stats.mean_nn;
         if (hsr_mask >> k & 1 && cone_radius > 0.0) {
@@ -394,7 +405,7 @@ static size_t particles_gpu_bytes(const void *opaque)
     if (!s)
         return 0;
     return s->gpu_bytes + pt_hsr_bytes(&s->hsr) + pt_contours_bytes(&s->contours) + pt_focus_bytes(&s->focus) +
-           pt_hatch_bytes(&s->hatch);
+           pt_hatch_bytes(&s->hatch) + (size_t)PT_TF2D_SETS * PT_TF2D_SIZE * PT_TF2D_SIZE * 4;
 }
 
 static void particles_prepare_stats(const void *opaque, sl_prepare_stats *out)

@@ -19,6 +19,7 @@
 #include "../core/sl_camera.h"
 #include "../core/sl_params.h"
 #include "particles_system.h"
+#include "particles_tf2d.h"
 
 typedef struct pt_frame {
     const sl_view *view;
@@ -37,6 +38,7 @@ typedef struct pt_set_view {
     int ink_dark;             /* ink darker than the background: tone = 1 - diffuse */
     int hsr;                  /* the id texture holds this set's visibility */
     GLuint id_tex;            /* R32UI, particle index + 1 (0 = none), view sized */
+    pt_curvature_lookup curvature; /* the set's 2D transfer function (particles_tf2d.h); zero = off */
 } pt_set_view;
 
 void pt_frame_init(pt_frame *f, const sl_view *view, const sl_params *params, sl_vec3 volume_origin,

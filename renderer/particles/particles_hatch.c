@@ -15,6 +15,7 @@
 
 #include "../gpu/sl_gpu.h"
 #include "particles_debug.h"
+#include "particles_tf2d.h"
 
 #define PT_HATCH_GROUP 64
 
@@ -198,6 +199,7 @@ sl_status pt_hatch_draw(pt_hatch *h, const pt_frame *f, const pt_set_view *sv, d
     glUniform3fv(glGetUniformLocation(p, "u_light_world"), 1, f->light_world);
     glUniform1i(glGetUniformLocation(p, "u_ink_dark"), sv->ink_dark);
     glUniform3fv(glGetUniformLocation(p, "u_ink"), 1, sv->ink);
+    pt_tf2d_uniforms(p, &sv->curvature, 1);
     glUniform1i(glGetUniformLocation(p, "u_segments"), c->key.segments);
     glUniform1i(glGetUniformLocation(p, "u_strokes"), strokes);
     glUniform1f(glGetUniformLocation(p, "u_half_width"), (float)(0.5 * sl_params_float(params, "hatch_width")));
@@ -211,6 +213,7 @@ sl_status pt_hatch_draw(pt_hatch *h, const pt_frame *f, const pt_set_view *sv, d
     glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glDrawArrays(GL_TRIANGLES, 0, quads * 6);
     glDisable(GL_BLEND);
+    glBindTextureUnit(1, 0);
     *drawn += quads;
     return SL_OK;
 }

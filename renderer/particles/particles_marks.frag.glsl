@@ -1,9 +1,8 @@
 // particles_marks.frag.glsl — a round stipple with analytic coverage (a
 // one-pixel ramp at the rim), premultiplied for (ONE, ONE_MINUS_SRC_ALPHA)
 // blending; fragments outside the dot are discarded so they write no depth.
-uniform vec3 u_ink;
-
 flat in float v_diameter;
+flat in vec3 v_color;    // the ink, or the curvature colour
 
 layout(location = 0) out vec4 o_color;
 
@@ -14,5 +13,5 @@ void main()
     float coverage = clamp(0.5 * v_diameter - r_px + 0.5, 0.0, 1.0);
     if (coverage <= 0.0)
         discard;
-    o_color = vec4(u_ink * coverage, coverage);
+    o_color = vec4(v_color * coverage, coverage);
 }

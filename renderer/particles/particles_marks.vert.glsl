@@ -6,10 +6,13 @@
 // (a zoom does not change the tone). Tone from the diffuse term d = max(0,
 // n.l) with n facing the viewer: dark ink on a light background wants
 // 1 - d, light ink on a dark background wants d; contrast stretches it about
-// 1/2, brightness shifts it towards less ink on a brighter picture.
-// Particles inside the focus sphere draw nothing.
+// 1/2, brightness shifts it towards less ink on a brighter picture. The
+// dot's colour: the ink, or with curvature colouring the set's 2D transfer
+// function at the particle's (k1, k2) (particles_tf2d.glsl). Particles
+// inside the focus sphere draw nothing.
 #include "gpu/glsl/camera.glsl"
 #include "particles/particles_record.glsl"
+#include "particles/particles_tf2d.glsl"
 
 uniform usampler2D u_ids;
 uniform int u_hsr;
@@ -19,14 +22,17 @@ uniform float u_stipple_size;  // in mean spacings
 uniform float u_brightness, u_contrast;
 uniform int u_ink_dark;
 uniform float u_max_point;
+uniform vec3 u_ink;
 
 flat out float v_diameter;
+flat out vec3 v_color;
 
 void cull()
 {
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     gl_PointSize = 1.0;
     v_diameter = 0.0;
+    v_color = vec3(0.0);
 }
 
 void main()
@@ -61,4 +67,5 @@ void main()
     gl_Position = clip;
     v_diameter = min(diameter, u_max_point - 2.0);
     gl_PointSize = v_diameter + 2.0;
+    v_color = pt_curvature_color(u_ink, r.n_k1.w, r.e1_k2.w);
 }

@@ -35,6 +35,7 @@ double pt_stipple_draw(pt_stipple *s, const pt_frame *f, const pt_set_view *sv, 
     glUniform1f(glGetUniformLocation(p, "u_contrast"), (float)sl_params_float(params, "stipple_contrast"));
     glUniform1i(glGetUniformLocation(p, "u_ink_dark"), sv->ink_dark);
     glUniform3fv(glGetUniformLocation(p, "u_ink"), 1, sv->ink);
+    pt_tf2d_uniforms(p, &sv->curvature, 1);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
@@ -42,5 +43,6 @@ double pt_stipple_draw(pt_stipple *s, const pt_frame *f, const pt_set_view *sv, 
     glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glDrawArrays(GL_POINTS, 0, n);
     glDisable(GL_BLEND);
+    glBindTextureUnit(1, 0);
     return n;
 }

@@ -3,11 +3,11 @@
 // at its rim (anti-aliasing across the width), premultiplied for (ONE,
 // ONE_MINUS_SRC_ALPHA) blending; fragments outside are discarded so they
 // write no depth.
-uniform vec3 u_ink;
 uniform float u_half_width;
 
 noperspective in vec2 v_px;
 flat in float v_length;
+flat in vec3 v_color;
 
 layout(location = 0) out vec4 o_color;
 
@@ -18,5 +18,5 @@ void main()
     float coverage = clamp(u_half_width - dist + 0.5, 0.0, 1.0);
     if (coverage <= 0.0)
         discard;
-    o_color = vec4(u_ink * coverage, coverage);
+    o_color = vec4(v_color * coverage, coverage);
 }

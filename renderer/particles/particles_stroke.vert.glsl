@@ -9,9 +9,12 @@
 // u_hatch_threshold no stroke, u_cross_threshold <= b < u_hatch_threshold the
 // main stroke, below that main + cross. The quad covers the segment's
 // capsule of radius u_half_width + 1 px (round joins by overlap, one pixel of
-// coverage ramp); depth is the segment's, interpolated.
+// coverage ramp); depth is the segment's, interpolated. Colour: the ink, or
+// with curvature colouring the set's 2D transfer function at the (k1, k2)
+// stored with the segment's first vertex (particles_tf2d.glsl).
 #include "gpu/glsl/camera.glsl"
 #include "particles/particles_record.glsl"
+#include "particles/particles_tf2d.glsl"
 
 layout(std430, binding = 6) readonly buffer pt_strokes { vec4 pt_vertex[]; };
 
@@ -19,6 +22,7 @@ uniform usampler2D u_ids;
 uniform int u_hsr;
 uniform vec3 u_light_world;      // unit, towards the light
 uniform int u_ink_dark;
+uniform vec3 u_ink;
 uniform int u_segments;          // K
 uniform int u_strokes;           // 1 or 2 per particle
 uniform float u_half_width;      // px
@@ -26,12 +30,14 @@ uniform float u_hatch_threshold, u_cross_threshold;
 
 noperspective out vec2 v_px;     // along (from the segment's start) and across, px
 flat out float v_length;         // segment length, px
+flat out vec3 v_color;
 
 void cull()
 {
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     v_px = vec2(0.0);
     v_length = 0.0;
+    v_color = vec3(0.0);
 }
 
 vec2 window_of(vec4 clip)
@@ -90,6 +96,8 @@ void main()
     vec2 w = (e == 0 ? wa - h * along : wc + h * along) + side * h * across;
     v_px = vec2(e == 0 ? -h : len + h, side * h);
     v_length = len;
+    vec2 k = unpackHalf2x16(floatBitsToUint(pt_vertex[base].w));
+    v_color = pt_curvature_color(u_ink, k.x, k.y);
     vec2 ndc = w / sl_viewport.xy * 2.0 - 1.0;
     gl_Position = vec4(ndc * ce.w, ce.z, ce.w);
 }

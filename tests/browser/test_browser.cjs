@@ -20,7 +20,10 @@
 // technique picker lists only what renders the dataset's kind; picking a
 // volume switches to the first volume technique in one scene message and a
 // volume frame arrives), the transfer-function editor (a dragged opacity
-// point, throttled; a point's colour; a colormap preset), "load view" (the saved view's dataset, technique, params
+// point, throttled; a point's colour; a colormap preset), the 2D curvature
+// editor of particles (tf2d_editor.js: its JS rule against the C bake at
+// five points, a dragged widget, a resized one, one added and deleted, and
+// the new frame), "load view" (the saved view's dataset, technique, params
 // and camera come back), and control hand-over to the second page (request,
 // grant, the new controller's change reaches the server, the old one's
 // controls are disabled). Screenshots go to <source>/build/ (CI artifact).
@@ -314,6 +317,7 @@ async function driveControls(page, obs, sess, saved) {
   // dataset of another kind switches to the first technique that accepts it,
   // in one scene message (no error), and a frame of it arrives.
   await volumeScene(page, obs, sess, banner);
+  await particlesTf2d(page, obs, sess, banner);
 
   // Load view: the saved view's dataset, technique, params and camera return.
   await page.selectOption('#views', saved.name);
@@ -463,6 +467,124 @@ async function volumeScene(page, obs, sess, banner) {
   await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
 }
 
+// particles on Marschner-Lobb: the transfer_2d entry is the 2D editor of
+// tf2d_editor.js (a canvas, no JSON field); its JS rule gives the colours
+// tests/unit/test_particles_tf2d.c computes with the C bake at five points
+// (the only numbers copied from there); with curvature colouring on, a
+// dragged widget, a rim drag, a double-click and Delete reach the server as
+// the new function, and the frame changes.
+async function particlesTf2d(page, obs, sess, banner) {
+  await page.selectOption('#dataset', 'marschner_lobb');
+  check(await serverStateWhere(obs, sess, (s) => s.dataset === 'marschner_lobb' && Array.isArray(s.bounds), 'ML', 60000),
+    'marschner_lobb loaded');
+  await page.selectOption('#technique', 'particles');
+  let st = await serverStateWhere(obs, sess, (s) => s.technique === 'particles', 'particles', 60000);
+  check(st, 'technique particles on the server');
+  await page.waitForFunction(() => window.sightline.state.technique === 'particles', null, { timeout: T });
+  await page.waitForFunction(() => window.sightline.lastFrame && !window.sightline.lastFrame.interactive &&
+    window.sightline.lastFrame.stateVersion >= window.sightline.stateVersion, null, { timeout: 3 * T });
+  check((await banner()) === '', `no error on particles (${await banner()})`);
+  const schema = await page.evaluate(() => window.sightline.techniques.find((t) => t.name === 'particles').params);
+  const def = schema.find((d) => d.type === 'transfer_2d');
+  const mask = schema.find((d) => d.unit === 'sets' && /curvature/.test(d.name));
+  check(def && mask, `particles has a transfer_2d entry (${def && def.name}) and its mask (${mask && mask.name})`);
+  if (!def || !mask) return;
+  const cv = page.locator(`#params canvas[data-param=${def.name}]`);
+  check((await cv.count()) === 1 && (await page.locator(`#params textarea[name=${def.name}], #params input[type=text][name=${def.name}]`).count()) === 0,
+    `${def.name} is the 2D editor's canvas, not a text field`);
+
+  // The JS rule against the C bake (test_particles_tf2d.c, js_expect).
+  const expect = [[0.873999834, 0.292935517, 0.161415202], [0.183359193, 0.341679597, 0.895801008],
+    [0.341540717, 0.667945805, 0.387048011], [0.508428272, 0.412202012, 0.483200028], [0.5, 0.5, 0.5]];
+  const js = await page.evaluate(async () => {
+    const { tf2dColour } = await import('/tf2d_editor.js');
+    const widgets = [[0.2, 0.0, 0.25, 1.0, 0.2, 0.1, 0.9], [0.0, -0.2, 0.3, 0.1, 0.3, 1.0, 0.8],
+      [0.15, -0.1, 0.15, 0.2, 0.9, 0.3, 0.6]];
+    const texel = (i) => -0.5 + (i + 0.5) / 64;   // texel centres of range 0.5
+    return [[44, 32], [32, 20], [41, 25], [36, 30], [60, 2]].map(([i, j]) =>
+      tf2dColour(widgets, [0.5, 0.5, 0.5], texel(i), texel(j)));
+  });
+  const worst = Math.max(...js.flatMap((c, p) => c.map((x, k) => Math.abs(x - expect[p][k]))));
+  check(worst < 1e-6, `the page's rule equals the C bake at 5 points (largest difference ${worst})`);
+
+  // Curvature colouring on for set 0: End on a slider (15), or set 0's check
+  // box when the page shows the mask as boxes (input[name=<mask>], bit 0 first).
+  const slider = page.locator(`#params input[type=range][name=${mask.name}]`);
+  if (await slider.count()) {
+    await slider.focus();
+    await page.keyboard.press('End');
+  } else {
+    await page.locator(`#params input[type=checkbox][name=${mask.name}]`).first().check();
+  }
+  check(await serverStateWhere(obs, sess, (s) => (s.params[mask.name] & 1) === 1, mask.name),
+    `${mask.name} has set 0's bit on the server`);
+  await settled(page);
+  const f0 = await canvasStats(page);
+  const id0 = await page.evaluate(() => window.sightline.lastFrame.frameId);
+
+  // Drag widget 1's centre by +range/2 in k1 (20 steps, throttled).
+  const v0 = (await observeOnce(obs, sess.session, sess.token)).params[def.name];
+  const r = v0.range;
+  await cv.scrollIntoViewIfNeeded();
+  let box = await cv.boundingBox();
+  const at = (k1, k2) => [box.x + ((k1 + r) / (2 * r)) * box.width, box.y + (1 - (k2 + r) / (2 * r)) * box.height];
+  const w1 = v0.widgets[1];
+  await page.evaluate(() => { window.sightline.sent.length = 0; });
+  const [x0, y0] = at(w1[0], w1[1]);
+  const [x1] = at(w1[0] + r / 2, w1[1]);
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  for (let i = 1; i <= 20; i++) await page.mouse.move(x0 + (x1 - x0) * i / 20, y0);
+  await page.mouse.up();
+  const tol = 0.02 * r;
+  st = await serverStateWhere(obs, sess, (s) => {
+    const w = s.params[def.name].widgets[1];
+    return w && Math.abs(w[0] - (w1[0] + r / 2)) < tol && Math.abs(w[1] - w1[1]) < tol && w[2] === w1[2];
+  }, 'tf2d drag');
+  check(st, `dragged widget 1 reached the server: ${JSON.stringify(st && st.params[def.name].widgets[1])}`);
+  const sets = await page.evaluate((n) => window.sightline.sent.filter((m) => m.type === 'set' && m.params &&
+    n in m.params).length, def.name);
+  check(sets >= 1 && sets < 20, `a 20-step widget drag sent ${sets} throttled set messages`);
+  await settled(page);
+  const f1 = await canvasStats(page);
+  const id1 = await page.evaluate(() => window.sightline.lastFrame.frameId);
+  check(id1 > id0 && f1.hash !== f0.hash, `the moved widget changed the frame (${id0} -> ${id1}, pixels differ)`);
+
+  // The rim handle (at k1 + radius, or k1 - radius when that is off the
+  // square) of the moved widget: outwards to twice the radius (or the edge).
+  const w1b = st.params[def.name].widgets[1];
+  await cv.scrollIntoViewIfNeeded();
+  box = await cv.boundingBox();
+  const right = w1b[0] + w1b[2] <= r;
+  const want = right ? Math.min(2 * w1b[2], r - w1b[0]) : Math.min(2 * w1b[2], w1b[0] + r);
+  const [rx, ry] = at(w1b[0] + (right ? 1 : -1) * w1b[2], w1b[1]);
+  const [rx2] = at(w1b[0] + (right ? 1 : -1) * want, w1b[1]);
+  await page.mouse.move(rx, ry);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; i++) await page.mouse.move(rx + (rx2 - rx) * i / 10, ry);
+  await page.mouse.up();
+  st = await serverStateWhere(obs, sess, (s) => Math.abs(s.params[def.name].widgets[1][2] - want) < tol, 'tf2d rim');
+  check(st, `the rim drag set widget 1's radius to ${want.toFixed(3)}: ${JSON.stringify(st && st.params[def.name].widgets[1])}`);
+
+  // Double-click adds a widget (reachable corner, away from the others); Delete removes it.
+  await cv.scrollIntoViewIfNeeded();
+  box = await cv.boundingBox();
+  const n0 = st ? st.params[def.name].widgets.length : v0.widgets.length;
+  await page.mouse.dblclick(...at(0.9 * r, -0.9 * r));
+  st = await serverStateWhere(obs, sess, (s) => s.params[def.name].widgets.length === n0 + 1, 'tf2d add');
+  const added = st && st.params[def.name].widgets[n0];
+  check(added && Math.abs(added[0] - 0.9 * r) < tol && Math.abs(added[1] + 0.9 * r) < tol,
+    `double-click added widget ${n0} at (${0.9 * r}, ${-0.9 * r}): ${JSON.stringify(added)}`);
+  await page.mouse.click(...at(added ? added[0] : 0.9 * r, added ? added[1] : -0.9 * r));   // selects it
+  await page.keyboard.press('Delete');
+  check(await serverStateWhere(obs, sess, (s) => s.params[def.name].widgets.length === n0, 'tf2d delete'),
+    `Delete removed it (${n0} widgets on the server)`);
+  await settled(page);
+  check((await banner()) === '', `no error after the 2D editor's changes (${await banner()})`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-particles.png') });
+  await cv.screenshot({ path: path.join(ARTIFACTS, 'browser-test-tf2d-editor.png') });
+}
+
 // The two attribute rules of controls.js on a synthetic schema, so they
 // cannot be met by knowing parameter names: an 'attribute' parameter of any
 // name becomes a select, an 'int' named "attribute" stays a slider.
@@ -521,21 +643,19 @@ async function synthetic(page) {
 // synthetic schema: an int with unit "sets" is 4 check boxes whose bits make
 // the value; a 'values' list is a text field whose numbers are sent only
 // when each lies in the schema range and there are at most max_count ([] =
-// auto); a 'transfer_2d' is a JSON field, sent when its shape is right.
+// auto). (A 'transfer_2d' is the 2D editor: see the particles section.)
 async function syntheticNewTypes(page) {
   const r = await page.evaluate(async () => {
     const { ParamControls } = await import('/controls.js');
     const form = document.createElement('form');
     const sent = [];
     const pc = new ParamControls(form, (n, v) => sent.push([n, v]));
-    const tf2d = { range: 0.5, widgets: [[0.25, 0, 0.3, 0.95, 0.95, 0.9, 1], [0, -0.25, 0.3, 0.1, 0.1, 0.1, 1]] };
     pc.build([
       { name: 'zz_mask', type: 'int', min: 0, max: 15, default: 1, unit: 'sets', description: '' },
       { name: 'zz_iso', type: 'values', min: 0, max: 255, max_count: 4, default: [], unit: 'data', description: '' },
-      { name: 'zz_ctf', type: 'transfer_2d', max_widgets: 16, default: tf2d, unit: '1/voxel', description: '' },
       { name: 'zz_count', type: 'int', min: 0, max: 15, default: 1, unit: '', description: '' },
     ]);
-    pc.update({ zz_mask: 5, zz_iso: [], zz_ctf: tf2d });
+    pc.update({ zz_mask: 5, zz_iso: [] });
     const boxes = [...form.querySelectorAll('input[type=checkbox][name=zz_mask]')];
     const shownMask = boxes.map((b) => b.checked);
     const labels = boxes.map((b) => b.parentElement.textContent.trim());
@@ -552,24 +672,15 @@ async function syntheticNewTypes(page) {
     type(iso, '10, 300');            // out of range: not sent
     type(iso, '10, x');              // not a number: not sent
     type(iso, '');                   // empty = auto
-    const ctf = form.querySelector('textarea[name=zz_ctf]');
-    const shownCtf = JSON.parse(ctf.value);
-    const summary = ctf.parentElement.querySelector('small').textContent;
-    type(ctf, '{"range": 1, "widgets": [[0, 0, 0.2, 1, 0, 0, 1]]}');
-    type(ctf, '{"range": 1, "widgets": [[0, 0, 0.2]]}'); // a short widget: not sent
-    type(ctf, '{"range": 1');                            // not JSON: not sent
-    return { shownMask, labels, shownIso, fifthInvalid, shownCtf, summary, sent,
+    return { shownMask, labels, shownIso, fifthInvalid, sent,
       countIsSlider: !!form.querySelector('input[type=range][name=zz_count]') };
   });
   check(same(r.shownMask, [true, false, true, false]) && same(r.labels, ['set 0', 'set 1', 'set 2', 'set 3']),
     `"sets" check boxes show mask 5 ${JSON.stringify([r.shownMask, r.labels])}`);
   check(r.countIsSlider, 'an int without unit "sets" stays a slider');
   check(r.shownIso === '' && r.fifthInvalid, `values field: empty = auto, a 5th value marked ${JSON.stringify(r)}`);
-  check(same(r.shownCtf, { range: 0.5, widgets: [[0.25, 0, 0.3, 0.95, 0.95, 0.9, 1], [0, -0.25, 0.3, 0.1, 0.1, 0.1, 1]] }) &&
-    r.summary === '2 widgets over ±0.5', `transfer_2d field shows the value ${JSON.stringify([r.shownCtf, r.summary])}`);
-  check(same(r.sent, [['zz_mask', 7], ['zz_mask', 6], ['zz_iso', [10, 20.5]], ['zz_iso', []],
-    ['zz_ctf', { range: 1, widgets: [[0, 0, 0.2, 1, 0, 0, 1]] }]]),
-  `sets / values / transfer_2d send only valid values ${JSON.stringify(r.sent)}`);
+  check(same(r.sent, [['zz_mask', 7], ['zz_mask', 6], ['zz_iso', [10, 20.5]], ['zz_iso', []]]),
+    `sets / values send only valid values ${JSON.stringify(r.sent)}`);
 }
 
 // Control hand-over: the viewer asks, the controller grants, the server says

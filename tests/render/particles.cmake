@@ -499,3 +499,40 @@ pt_test(hatch.goldens ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-regress>|${PT_DIR}/goldens_hatch|--out|${PT_OUT}/goldens_hatch|--jobs|2"
   "-DOUT1=3 cases, 3 passed, 0 failed, 0 errors"
   ${SL_STEPS})
+
+# ---- curvature transfer function (curvature_coloring, curvature_tf;
+# renderer/particles/particles_tf2d.h). tf2d-check judges the colour of the
+# torus seen along its axis (64^3, iso 0, dark inside: k1 = +0.107 per voxel
+# at the inner equator, 0 on top, -0.040 at the outer equator; k2 = -0.127)
+# with red at k1 = +0.08 and blue at -0.08 (equal weights at k1 = 0): red
+# inside 23 px (the top ring, radius 0.55, at 128x128), blue outside.
+# Measured: inside red share 1.000 (629 px), outside blue share 1.000
+# (845 px); between 22 and 24 px the shares stay 1.000. With the colouring off (the set's bit 0)
+# or the two colours swapped the check must fail. Goldens: the suite
+# goldens_tf2d (the red/blue torus and the default function over a grey
+# ink); after a deliberate change: sightline-regress
+# tests/render/particles/goldens_tf2d --update, and look at them.
+add_executable(tf2d-check ${PT_DIR}/tf2d_check.c)
+target_link_libraries(tf2d-check PRIVATE sightline_renderer)
+set_target_properties(tf2d-check PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+set(PT_TF2D_RB "{\"range\":0.25,\"widgets\":[[0.08,-0.13,0.12,1,0,0,1],[-0.08,-0.13,0.12,0,0,1,1]]}")
+set(PT_TF2D_BR "{\"range\":0.25,\"widgets\":[[0.08,-0.13,0.12,0,0,1,1],[-0.08,-0.13,0.12,1,0,0,1]]}")
+set(PT_TF2D_CAM "{\"orbit\":{\"azimuth\":0,\"elevation\":0,\"distance\":2.2},\"fov_y\":45}")
+foreach(case "follows_curvature;1;${PT_TF2D_RB};0" "detects_off;0;${PT_TF2D_RB};1" "detects_swap;1;${PT_TF2D_BR};1")
+  list(GET case 0 name)
+  list(GET case 1 mask)
+  list(GET case 2 tf)
+  list(GET case 3 exit)
+  set(PT_TF2D_LINE "-DOUT2=inside 23 px: red share 1.000.*blue share 1.000")
+  if(exit)
+    set(PT_TF2D_LINE "-DERR2=tf2d-check: needs at least")
+  endif()
+  pt_test(tf2d.${name} ${CMAKE_COMMAND}
+    "-DSTEP1=${PT_RENDER}|--scene|${PT_BASE}|--set|dataset=${PT_TORUS64}|--set|camera=${PT_TF2D_CAM}|--set|params={\"isovalues\":[0],\"stipple_size\":1.0,\"curvature_coloring\":${mask},\"curvature_tf\":${tf}}|--out|${PT_OUT}/tf2d_${name}.png"
+    "-DSTEP2=$<TARGET_FILE:tf2d-check>|--png|${PT_OUT}/tf2d_${name}.png|--split|23" -DEXIT2=${exit} "${PT_TF2D_LINE}"
+    ${SL_STEPS})
+endforeach()
+pt_test(goldens_tf2d ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-regress>|${PT_DIR}/goldens_tf2d|--out|${PT_OUT}/goldens_tf2d|--jobs|2"
+  "-DOUT1=2 cases, 2 passed, 0 failed, 0 errors"
+  ${SL_STEPS})
