@@ -79,6 +79,8 @@ typedef struct particles_state {
     const sl_dataset *dataset;      /* borrowed */
     sl_volume_geometry geom;
     sl_volume_texture volume;
+    sl_volume_bricks bricks;           /* min-max bricks: placement skips the tiles no isovalue crosses */
+    double bricks_ms;
     pt_system *system;
     int set_count;
     double iso[PT_MAX_SETS];
@@ -100,6 +102,7 @@ static void particles_release(void *opaque)
         pt_set_release(&s->sets[k]);
     pt_system_destroy(s->system);
     sl_volume_texture_destroy(&s->volume);
+    sl_volume_bricks_destroy(&s->bricks);
     pt_hsr_deinit(&s->hsr);
     pt_stipple_deinit(&s->stipple);
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
@@ -138,7 +141,7 @@ static void add_extra(sl_prepare_stats *p, const char *name, double value)
 
 static void fill_prepare_stats(particles_state *s)
 {
-    double placement = 0, sort = 0, lookup = 0, energy = 0, final = 0, preprocess = 0;
+    double placement = s->bricks_ms, sort = 0, lookup = 0, energy = 0, final = 0, preprocess = 0;
     char name[32];
     for (int k = 0; k < s->set_count; k++) {
         const pt_set_stats *st = &s->sets[k].stats;
@@ -185,6 +188,10 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         goto fail;
     glFinish();
     s->prep.upload_ms = sl_clock_ms() - t_upload;
+    double t_bricks = sl_clock_ms();
+    if ((st = sl_volume_bricks_create(&ds->volume, &s->bricks, err)) != SL_OK)
+        goto fail;
+    s->bricks_ms = sl_clock_ms() - t_bricks;
     if ((st = pt_system_create(&s->system, err)) != SL_OK || (st = pt_hsr_init(&s->hsr, err)) != SL_OK ||
         (st = pt_stipple_init(&s->stipple, err)) != SL_OK)
         goto fail;
@@ -193,7 +200,8 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
                       .value_offset = s->volume.value_offset,
                       .min_spacing = s->geom.min_spacing,
                       .value_min = ds->volume.value_min,
-                      .value_max = ds->volume.value_max};
+                      .value_max = ds->volume.value_max,
+                      .bricks = &s->bricks};
     for (int a = 0; a < 3; a++) {
         field.dims[a] = ds->volume.dims[a];
         field.spacing[a] = ds->volume.spacing[a];
@@ -220,7 +228,7 @@ static sl_status particles_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     s->max_point = range[1];
     if ((st = sl_gl_check_errors("particles: preparing", err)) != SL_OK)
         goto fail;
-    s->gpu_bytes += s->volume.bytes;
+    s->gpu_bytes += s->volume.bytes + s->bricks.bytes;
     fill_prepare_stats(s);
     *out = s;
     return SL_OK;

@@ -26,6 +26,7 @@
 #include <epoxy/gl.h>
 
 #include "../core/sl_status.h"
+#include "../volume/sl_volume.h"
 #include "particles_sort.h"
 
 /* The volume as the passes read it (a sl_volume_texture and its geometry). */
@@ -36,6 +37,7 @@ typedef struct pt_field {
     double spacing[3];            /* world units per voxel */
     double min_spacing;
     double value_min, value_max;  /* finite data range */
+    const sl_volume_bricks *bricks; /* borrowed min-max bricks of the same volume; NULL: no skipping */
 } pt_field;
 
 typedef struct pt_system_desc {
@@ -47,6 +49,8 @@ typedef struct pt_system_desc {
     pt_sort_method sort;
     pt_lookup_method lookup;
     uint32_t max_particles;       /* seeds above: SL_ERR_LIMIT */
+    int no_skipping;              /* 1: the whole lattice and bins over the whole volume box (same
+                                   * particles, for checks and benchmarks) */
 } pt_system_desc;
 
 typedef struct pt_set_stats {
@@ -58,6 +62,7 @@ typedef struct pt_set_stats {
     double mean_nn, nn_cv;        /* nearest-neighbour distance (world) over alive particles with one */
     double placement_ms, id_sort_ms, sort_ms, lookup_ms, gather_ms, energy_ms, settle_ms, final_ms;
     double ms_per_step;           /* keys + sort + gather + table + energy + read-back, per step */
+    uint32_t tiles, tiles_total;  /* lattice tiles of 4^3 points dispatched, of all */
 } pt_set_stats;
 
 typedef struct pt_set {
@@ -65,6 +70,7 @@ typedef struct pt_set {
     GLuint table;                 /* uint start[bins + 1] of the last sort */
     uint32_t count;               /* records held (alive + dead) */
     double bin_size;              /* world */
+    int bin_origin[3];            /* first bin of the grid over the volume box (see choose_bins) */
     int bin_dims[3];
     uint32_t bins;
     pt_set_stats stats;
