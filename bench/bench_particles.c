@@ -2,7 +2,7 @@
  * the targets, and VTK's isosurface as the peer.
  *
  *   bench-particles [--small | --size WxH] [--frames N] [--counts 10000,30000,60000,100000,200000]
- *                   [--steps 0,5,10,25,50] [--part 1..5] [--reps R] [--no-vtk]
+ *                   [--steps 0,5,10,25,50] [--part 1..5] [--reps R] [--no-vtk] [--only KEY]
  *
  * van Pelt, Vilanova, van de Wetering, "Illustrative Volume Visualization
  * Using GPU-Based Particle Systems", sec. 5, Table 2, Table 3, Fig. 11;
@@ -53,6 +53,7 @@
 #define PROGRAM "bench-particles"
 #define MAX_LIST 12
 #define REPULSION 1.6 /* the schema's default repulsion_radius (lattice steps) */
+#define LOOKUP PT_LOOKUP_BINARY_SEARCH /* the schema's default look-up */
 
 typedef struct options {
     sl_bench_options bench;
@@ -61,6 +62,7 @@ typedef struct options {
     int parts;   /* bit k: part k + 1 */
     int reps;    /* repetitions of the interleaved A/B */
     int no_vtk;
+    const char *only;  /* a dataset key (ct-skin, ct-bone, mri-skin, sphere, torus), or NULL: all */
 } options;
 
 /* ---- datasets ---- */
@@ -89,10 +91,14 @@ static const sl_technique *particles(void)
     return sl_technique_find("particles");
 }
 
-static sl_status vol_load(vol *v, sl_err *err)
+static sl_status vol_load(vol *v, const char *only, sl_err *err)
 {
     double t0 = sl_clock_ms();
     sl_status st;
+    if (only && strcmp(only, v->key) != 0) {
+        snprintf(v->why, sizeof v->why, "not run (--only %s)", only);
+        return SL_OK;
+    }
     if (v->file) {
         char path[1024];
         snprintf(path, sizeof path, "%s/data/samples/%s", source_dir(), v->file);
@@ -182,7 +188,7 @@ static sl_status build(pt_system *sys, const vol *v, const build_desc *bd, run *
 /* The spacing for about `target` particles: N1 at spacing 1, s = sqrt(N1 / N), one correction. */
 static sl_status spacing_for(pt_system *sys, const vol *v, int target, double *spacing, sl_err *err)
 {
-    build_desc bd = {.spacing = 1.0};
+    build_desc bd = {.spacing = 1.0, .lookup = LOOKUP};
     run r;
     sl_status st = build(sys, v, &bd, &r, NULL, err);
     if (st != SL_OK)
@@ -395,7 +401,7 @@ static sl_status part1(sl_gpu *gpu, pt_system *sys, const options *o, vol *v, ta
 {
     memset(tb, 0, sizeof *tb);
     sl_status st = spacing_for(sys, v, 60000, &tb->spacing, err);
-    build_desc bd = {.spacing = tb->spacing, .steps = 25};
+    build_desc bd = {.spacing = tb->spacing, .steps = 25, .lookup = LOOKUP};
     if (st == SL_OK)
         st = build(sys, v, &bd, &tb->r25, NULL, err);
     bd.steps = 15;
@@ -515,7 +521,7 @@ static void part2(pt_system *sys, const options *o, vol *const *vs, int n, sl_er
            "\"for particle sets up to 100,000 particles, the redistribution time stays well under five seconds\" "
            "(Fig. 11a, 8800 GTX).\n\n");
     printf("| dataset | particles | spacing | bins | placement ms | sort ms/step radix \\| bitonic | look-up ms/step "
-           "prefix_sum \\| binary_search | energy ms/step | redistribution 25 steps ms (radix, prefix_sum) | GPU MB |"
+           "prefix_sum \\| binary_search | energy ms/step | redistribution 25 steps ms (radix, binary_search) | GPU MB |"
            "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < n; k++) {
         if (!vs[k]->ds) {
@@ -530,9 +536,9 @@ static void part2(pt_system *sys, const options *o, vol *const *vs, int n, sl_er
                 continue;
             }
             run r[3];
-            const build_desc bd[3] = {{spacing, 25, 0.0, PT_SORT_RADIX, PT_LOOKUP_PREFIX_SUM, 0},
-                                      {spacing, 25, 0.0, PT_SORT_BITONIC, PT_LOOKUP_PREFIX_SUM, 0},
-                                      {spacing, 25, 0.0, PT_SORT_RADIX, PT_LOOKUP_BINARY_SEARCH, 0}};
+            const build_desc bd[3] = {{spacing, 25, 0.0, PT_SORT_RADIX, PT_LOOKUP_BINARY_SEARCH, 0},
+                                      {spacing, 25, 0.0, PT_SORT_BITONIC, PT_LOOKUP_BINARY_SEARCH, 0},
+                                      {spacing, 25, 0.0, PT_SORT_RADIX, PT_LOOKUP_PREFIX_SUM, 0}};
             int ok = 1;
             for (int m = 0; m < 3 && ok; m++)
                 ok = build(sys, vs[k], &bd[m], &r[m], NULL, err) == SL_OK;
@@ -543,7 +549,7 @@ static void part2(pt_system *sys, const options *o, vol *const *vs, int n, sl_er
             double per = r[0].s.steps + 1.0;
             printf("| %s | %u | %.3f | %u | %.0f | %.1f \\| %.1f | %.1f \\| %.1f | %.1f | %.0f | %.1f |\n",
                    vs[k]->label, r[0].s.alive, spacing, r[0].bins, r[0].s.placement_ms, r[0].s.sort_ms / per,
-                   r[1].s.sort_ms / per, r[0].s.lookup_ms / per, r[2].s.lookup_ms / per,
+                   r[1].s.sort_ms / per, r[2].s.lookup_ms / per, r[0].s.lookup_ms / per,
                    r[0].s.energy_ms / fmax(r[0].s.steps, 1), r[0].redistribution_ms, r[0].bytes / 1e6);
         }
     }
@@ -552,8 +558,9 @@ static void part2(pt_system *sys, const options *o, vol *const *vs, int n, sl_er
 /* The skipping against the whole lattice and whole-box bins, interleaved, o->reps times each. */
 static void part2_ab(pt_system *sys, const options *o, vol *const *vs, int n, sl_err *err)
 {
-    printf("\n### Brick skipping and bins over the surface's bricks: before (whole lattice, bins over the whole "
-           "volume) / after, same run, interleaved (~60k, 25 steps, radix, prefix_sum; medians of %d)\n\n", o->reps);
+    printf("\n### Before / after, same run, interleaved ABBA (~60k, 25 steps, radix; medians of %d). Before: the whole "
+           "lattice, bins over the whole volume, look-up prefix_sum; after: only the lattice tiles whose bricks may "
+           "straddle the isovalue, bins over those bricks, look-up binary_search (the new default)\n\n", o->reps);
     printf("| dataset | particles | tiles dispatched / all | bins before → after | placement ms before → after "
            "(ratio) | look-up ms/step before → after (ratio) | sort ms/step before → after | energy ms/step before → "
            "after | 25 steps ms before → after (ratio) | same seeds |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
@@ -570,7 +577,8 @@ static void part2_ab(pt_system *sys, const options *o, vol *const *vs, int n, sl
         for (int rep = 0; rep < reps && ok; rep++)
             for (int ab = 0; ab < 2 && ok; ab++) {
                 int variant = (rep & 1) ? 1 - ab : ab; /* ABBA */
-                build_desc bd = {spacing, 25, 0.0, PT_SORT_RADIX, PT_LOOKUP_PREFIX_SUM, variant == 0};
+                /* before: the lead's code (whole lattice, bins over the volume, prefix_sum); after: ours */
+                build_desc bd = {spacing, 25, 0.0, PT_SORT_RADIX, variant ? LOOKUP : PT_LOOKUP_PREFIX_SUM, variant == 0};
                 fprintf(stderr, PROGRAM ": A/B %s rep %d %s\n", vs[k]->key, rep, variant ? "after" : "before");
                 ok = build(sys, vs[k], &bd, &r[variant], NULL, err) == SL_OK;
                 double per = r[variant].s.steps + 1.0;
@@ -655,7 +663,7 @@ static void set_metrics(const vol *v, const pt_set *set, double *p99, double *cv
 
 static sl_status part4(pt_system *sys, const options *o, vol *const *vs, int n, sl_err *err)
 {
-    printf("\n## 4. Run time against error (energy_tol 0, radix, prefix_sum)\n\n");
+    printf("\n## 4. Run time against error (energy_tol 0, radix, binary_search)\n\n");
     printf("Off-surface: |f - iso| / |grad f| (first order, trilinear in double, pref_trilinear) in voxels, p99; "
            "NN CV and packing ratio n pi (mean/2)^2 / area from the exact nearest neighbours (pref_nn; 0.907 = "
            "hexagonal); areas: sphere 4 pi 0.45^2, torus 4 pi^2 0.55 0.25. Redistribution ms = the steps alone.\n\n");
@@ -671,7 +679,7 @@ static sl_status part4(pt_system *sys, const options *o, vol *const *vs, int n, 
         if (vs[k]->file && (st = spacing_for(sys, vs[k], 60000, &spacing, err)) != SL_OK)
             return st;
         for (int s = 0; s < o->steps_n; s++) {
-            build_desc bd = {.spacing = spacing, .steps = o->steps[s]};
+            build_desc bd = {.spacing = spacing, .steps = o->steps[s], .lookup = LOOKUP};
             run r;
             pt_set set;
             fprintf(stderr, PROGRAM ": error %s steps %d\n", vs[k]->key, o->steps[s]);
@@ -750,11 +758,14 @@ static int parse_args(int argc, char **argv, options *o)
         } else if (strcmp(a, "--part") == 0 && v && sl_bench_parse_int(v, 1, 5, &part) == 0) {
             o->parts = 1 << (part - 1);
             i++;
+        } else if (strcmp(a, "--only") == 0 && v) {
+            o->only = argv[++i];
         } else if (strcmp(a, "--reps") == 0 && v && sl_bench_parse_int(v, 1, 16, &o->reps) == 0) {
             i++;
         } else {
             fprintf(stderr, "usage: " PROGRAM " %s [--counts 10000,30000,...] [--steps 0,5,10,25,50]\n"
-                            "       [--part 1..5] [--reps R (1..16)] [--no-vtk]\n", SL_BENCH_OPTIONS_HELP);
+                            "       [--part 1..5] [--reps R (1..16)] [--no-vtk] [--only ct-skin|ct-bone|mri-skin|sphere|"
+                            "torus]\n", SL_BENCH_OPTIONS_HELP);
             return 0;
         }
     }
@@ -788,7 +799,7 @@ int main(int argc, char **argv)
     vol *heads[3] = {&ct_skin, &ct_bone, &mri};
     sl_status st = SL_OK;
     for (int k = 0; k < 3 && st == SL_OK; k++)
-        st = vol_load(heads[k], &err);
+        st = vol_load(heads[k], o.only, &err);
     printf("# " PROGRAM " — %s\n\nUnder load or not: see the section heading in bench/RESULTS.md. Repulsion radius "
            "%.1f lattice steps (the default); the count of a row is chosen from a count-only run (N ~ 1/spacing^2, "
            "one correction).\n", sl_gpu_renderer(gpu), REPULSION);
@@ -809,7 +820,7 @@ int main(int argc, char **argv)
     if (st == SL_OK && (o.parts & 4))
         print_part3(&o, heads, tbp, 3);
     if (st == SL_OK && (o.parts & 8)) {
-        if ((st = vol_load(&sphere, &err)) == SL_OK && (st = vol_load(&torus, &err)) == SL_OK) {
+        if ((st = vol_load(&sphere, o.only, &err)) == SL_OK && (st = vol_load(&torus, o.only, &err)) == SL_OK) {
             vol *es[3] = {&sphere, &torus, &ct_skin};
             st = part4(sys, &o, es, 3, &err);
         }

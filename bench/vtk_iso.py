@@ -20,6 +20,7 @@ with /usr/bin/python3; bench/packages.txt lists the packages.
 """
 import argparse
 import json
+import os
 import sys
 import time
 
@@ -43,22 +44,31 @@ def main():
     except ValueError:
         fail("--size WxH")
     try:
-        import numpy
         import vtk
-        from vtk.util import numpy_support
     except ImportError as e:
-        fail("no VTK/numpy for %s (Debian: python3-vtk9): %s" % (sys.executable, e))
+        fail("no VTK for %s (Debian: python3-vtk9): %s" % (sys.executable, e))
     vtk.vtkObject.GlobalWarningDisplayOff()
 
     frames = read_cameras(a.cameras)
-    data = numpy.fromfile(a.raw, dtype=a.type)
-    if data.size != a.dims[0] * a.dims[1] * a.dims[2]:
-        fail("%s holds %d values, dims say %d" % (a.raw, data.size, a.dims[0] * a.dims[1] * a.dims[2]))
-    image = vtk.vtkImageData()
-    image.SetDimensions(*a.dims)
-    image.SetSpacing(*a.spacing)
-    image.SetOrigin(*a.origin)
-    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(data, deep=1))
+    sizes = {"float32": 4, "int16": 2, "uint16": 2, "uint8": 1}
+    voxels = a.dims[0] * a.dims[1] * a.dims[2]
+    if os.path.getsize(a.raw) != voxels * sizes[a.type]:
+        fail("%s holds %d bytes, dims and type say %d" % (a.raw, os.path.getsize(a.raw), voxels * sizes[a.type]))
+    reader = vtk.vtkImageReader2()  # no numpy needed
+    reader.SetFileName(a.raw)
+    reader.SetFileDimensionality(3)
+    reader.SetDataExtent(0, a.dims[0] - 1, 0, a.dims[1] - 1, 0, a.dims[2] - 1)
+    reader.SetDataSpacing(*a.spacing)
+    reader.SetDataOrigin(*a.origin)
+    reader.SetNumberOfScalarComponents(1)
+    {"float32": reader.SetDataScalarTypeToFloat, "int16": reader.SetDataScalarTypeToShort,
+     "uint16": reader.SetDataScalarTypeToUnsignedShort, "uint8": reader.SetDataScalarTypeToUnsignedChar}[a.type]()
+    if sys.byteorder == "little":
+        reader.SetDataByteOrderToLittleEndian()
+    else:
+        reader.SetDataByteOrderToBigEndian()
+    reader.Update()
+    image = reader.GetOutput()
 
     if hasattr(vtk, "vtkFlyingEdges3D"):
         iso = vtk.vtkFlyingEdges3D()

@@ -48,8 +48,9 @@ static const sl_param_def particles_params[] = {
      SL_INVALIDATE_PREPARED},
     {"sort", SL_PARAM_ENUM, 0, 0, {0}, sort_names, "",
      "GPU sort of the particles by bin: radix (stable, LSD) or bitonic (the paper's class)", SL_INVALIDATE_PREPARED},
-    {"lookup", SL_PARAM_ENUM, 0, 0, {0}, lookup_names, "",
-     "bin table: prefix sum of a histogram or a binary search per bin (the paper's); the same table",
+    {"lookup", SL_PARAM_ENUM, 0, 0, {1}, lookup_names, "",
+     "bin table: prefix sum of a histogram or a binary search per bin (the paper's, the default: faster on llvmpipe, "
+     "bench-particles); the same table",
      SL_INVALIDATE_PREPARED},
     {"max_particles", SL_PARAM_INT, 1000, 4000000, {1000000}, NULL, "",
      "particles per set at most: a denser lattice is refused with the numbers", SL_INVALIDATE_PREPARED},

@@ -4,8 +4,9 @@
  * (ping-pong: the energy step reads one in bin order and writes the other),
  * keys and values (4 B each, the sorter's), the energy per work group, the
  * bin table (4 B per bin) and at the end the records (48 B) and the
- * nearest-neighbour distances (4 B). Only the records and the table are
- * kept. Render thread only.
+ * nearest-neighbour distances (4 B), and the list of lattice tiles to
+ * place in (4 B per tile, built on the CPU from the min-max bricks). Only
+ * the records and the table are kept. Render thread only.
  */
 #include "particles_system.h"
 

@@ -3,7 +3,10 @@
  * 4.1 and 4.2.3; README.md "The particle system").
  *
  * pt_set_build places particles on the isosurface f = iso of the trilinear
- * field (Algorithm 1 on a lattice of `lattice_step` voxels), sorts them by
+ * field (Algorithm 1 on a lattice of `lattice_step` voxels; with the
+ * field's min-max bricks only the lattice tiles of 4^3 points whose bricks
+ * may straddle iso are dispatched, and the bins cover only those bricks:
+ * the same particles, plan §1.1 "Skipping"), sorts them by
  * edge id (a deterministic order), runs up to max_steps energy steps
  * (keys -> sort by bin -> gather -> bin table -> energy step -> group sums
  * read back and added in double; stop when the relative energy change is
