@@ -2,7 +2,7 @@
  * the targets, and VTK's isosurface as the peer.
  *
  *   bench-particles [--small | --size WxH] [--frames N] [--counts 10000,30000,60000,100000,200000]
- *                   [--steps 0,5,10,25,50] [--part 1..5] [--reps R] [--no-vtk] [--only KEY]
+ *                   [--steps 0,5,10,25,50] [--part 1..5 (repeatable)] [--reps R] [--no-vtk] [--only KEY]
  *
  * van Pelt, Vilanova, van de Wetering, "Illustrative Volume Visualization
  * Using GPU-Based Particle Systems", sec. 5, Table 2, Table 3, Fig. 11;
@@ -741,6 +741,7 @@ static int parse_args(int argc, char **argv, options *o)
     *o = (options){.counts = {10000, 30000, 60000, 100000, 200000}, .count_n = 5, .steps = {0, 5, 10, 25, 50},
                    .steps_n = 5, .parts = 0x1f, .reps = 3};
     sl_bench_options_init(&o->bench, 10);
+    int parts_given = 0;
     for (int i = 1; i < argc; i++) {
         int c = sl_bench_option(&o->bench, argc, argv, &i, PROGRAM);
         if (c < 0)
@@ -756,7 +757,7 @@ static int parse_args(int argc, char **argv, options *o)
         } else if (strcmp(a, "--steps") == 0 && v && parse_list(v, 0, 1000, o->steps, &o->steps_n)) {
             i++;
         } else if (strcmp(a, "--part") == 0 && v && sl_bench_parse_int(v, 1, 5, &part) == 0) {
-            o->parts = 1 << (part - 1);
+            o->parts = (parts_given++ ? o->parts : 0) | 1 << (part - 1); /* repeatable */
             i++;
         } else if (strcmp(a, "--only") == 0 && v) {
             o->only = argv[++i];
