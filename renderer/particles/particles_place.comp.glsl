@@ -9,7 +9,10 @@
 // only counts. Both variants see the same values, so the counts agree.
 // One shared counter per work group and one global atomicAdd per group;
 // the order of the emitted particles is not deterministic (the id sort after
-// it is). Dispatched in chunks: u_first is the first lattice index.
+// it is). Dispatched in chunks: u_first is the first lattice index, or with
+// u_tiled the first entry of pt_tiles: one work group per listed tile of
+// 4x4x4 lattice points (tile t = (x, y, z) packed x + tx (y + ty z)), the
+// tiles whose voxels may straddle the isovalue (particles_system.c).
 layout(local_size_x = 64) in;
 
 #include "particles/particles_common.glsl"
@@ -28,6 +31,9 @@ uniform float u_lattice_step;
 uniform ivec3 u_lattice_dims;
 uniform uint u_first;
 uniform uint u_total;
+uniform bool u_tiled;
+uniform uvec3 u_tile_dims;
+layout(std430, binding = 4) readonly buffer pt_tile_list { uint pt_tiles[]; };
 uniform float u_gmin;          // |grad f| (world) below this: emitted dead
 uniform float u_lambda0;
 
@@ -46,10 +52,21 @@ void main()
         group_count = 0u;
     barrier();
 
-    uint lin = u_first + gl_GlobalInvocationID.x;
-    bool inside = lin < u_total;
     uint lx = uint(u_lattice_dims.x), ly = uint(u_lattice_dims.y);
-    ivec3 idx = ivec3(lin % lx, (lin / lx) % ly, lin / (lx * ly));
+    uint lin;
+    bool inside;
+    ivec3 idx;
+    if (u_tiled) {
+        uint t = pt_tiles[u_first + gl_WorkGroupID.x], l = gl_LocalInvocationIndex;
+        uvec3 tile = uvec3(t % u_tile_dims.x, (t / u_tile_dims.x) % u_tile_dims.y, t / (u_tile_dims.x * u_tile_dims.y));
+        idx = ivec3(4u * tile + uvec3(l & 3u, (l >> 2) & 3u, l >> 4));
+        inside = all(lessThan(idx, u_lattice_dims));
+        lin = uint(idx.x) + lx * (uint(idx.y) + ly * uint(idx.z));
+    } else {
+        lin = u_first + gl_GlobalInvocationID.x;
+        inside = lin < u_total;
+        idx = ivec3(lin % lx, (lin / lx) % ly, lin / (lx * ly));
+    }
     vec3 r = vec3(idx) * u_lattice_step;
     vec3 g0;
     float f0 = inside ? pt_trilinear(r, g0) : 0.0;

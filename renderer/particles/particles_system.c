@@ -4,8 +4,9 @@
  * (ping-pong: the energy step reads one in bin order and writes the other),
  * keys and values (4 B each, the sorter's), the energy per work group, the
  * bin table (4 B per bin) and at the end the records (48 B) and the
- * nearest-neighbour distances (4 B). Only the records and the table are
- * kept. Render thread only.
+ * nearest-neighbour distances (4 B), and the list of lattice tiles to
+ * place in (4 B per tile, built on the CPU from the min-max bricks). Only
+ * the records and the table are kept. Render thread only.
  */
 #include "particles_system.h"
 
@@ -113,6 +114,7 @@ static void set_box_uniform(GLuint p, const pt_field *f)
 static void set_bin_uniforms(GLuint p, const pt_set *s)
 {
     u1f(p, "u_bin_size", s->bin_size);
+    glUniform3i(glGetUniformLocation(p, "u_bin_origin"), s->bin_origin[0], s->bin_origin[1], s->bin_origin[2]);
     glUniform3i(glGetUniformLocation(p, "u_bin_dims"), s->bin_dims[0], s->bin_dims[1], s->bin_dims[2]);
     u1ui(p, "u_bins", s->bins);
 }
@@ -140,23 +142,107 @@ static double phase_end(double t0)
 }
 
 typedef struct build_buffers {
-    GLuint particles[2], keys, values, group_energy, nearest, counter;
+    GLuint particles[2], keys, values, group_energy, nearest, counter, tiles;
 } build_buffers;
 
 static void free_build_buffers(build_buffers *b)
 {
     GLuint *all[] = {&b->particles[0], &b->particles[1], &b->keys, &b->values, &b->group_energy, &b->nearest,
-                     &b->counter};
+                     &b->counter, &b->tiles};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         if (*all[i])
             glDeleteBuffers(1, all[i]);
     memset(b, 0, sizeof *b);
 }
 
+/* The bricks the isovalue may cross: brick b (voxels [8b, 8b + 8] per axis)
+ * when min < iso + eps and max >= iso - eps over its finite values, eps
+ * covering the float rounding of the GPU's value map and interpolation (a
+ * crossing needs one value below iso and one at or above it, both
+ * interpolated from the brick's voxels). Returns a mask (malloc'd, 1 byte
+ * per brick) and the voxel box of the marked bricks in lo/hi (lo > hi: none),
+ * or NULL when out of memory. */
+static uint8_t *iso_bricks(const pt_field *f, double iso, int lo[3], int hi[3])
+{
+    const sl_volume_bricks *b = f->bricks;
+    size_t n = (size_t)b->dims[0] * (size_t)b->dims[1] * (size_t)b->dims[2];
+    uint8_t *mask = malloc(n ? n : 1);
+    if (!mask)
+        return NULL;
+    double eps = 1e-4 * (f->value_max - f->value_min) + 1e-6 * fabs(iso);
+    for (int a = 0; a < 3; a++)
+        lo[a] = INT32_MAX, hi[a] = -1;
+    size_t i = 0;
+    for (int z = 0; z < b->dims[2]; z++)
+        for (int y = 0; y < b->dims[1]; y++)
+            for (int x = 0; x < b->dims[0]; x++, i++) {
+                mask[i] = b->minmax[2 * i] < iso + eps && b->minmax[2 * i + 1] >= iso - eps;
+                if (!mask[i])
+                    continue;
+                int c[3] = {x, y, z};
+                for (int a = 0; a < 3; a++) {
+                    int v0 = SL_VOLUME_BRICK * c[a], v1 = v0 + SL_VOLUME_BRICK;
+                    v1 = v1 < f->dims[a] - 1 ? v1 : f->dims[a] - 1;
+                    lo[a] = v0 < lo[a] ? v0 : lo[a];
+                    hi[a] = v1 > hi[a] ? v1 : hi[a];
+                }
+            }
+    return mask;
+}
+
+/* The lattice tiles (4^3 points, packed x + tx (y + ty z)) whose voxels
+ * touch a marked brick: tile T spans lattice points 4T .. 4T + 4 (its edges
+ * end one point further), so the voxels floor(4 s T) .. floor(4 s (T + 1)) + 1
+ * per axis; every brick overlapping that range is looked at. Writes the list
+ * (malloc'd) into *out and its length into *count; -1 when out of memory. */
+static int lattice_tiles(const pt_field *f, const uint8_t *mask, double step, const int tdims[3], uint32_t **out,
+                         uint32_t *count)
+{
+    const sl_volume_bricks *b = f->bricks;
+    size_t total = (size_t)tdims[0] * (size_t)tdims[1] * (size_t)tdims[2];
+    uint32_t *list = malloc((total ? total : 1) * sizeof *list);
+    int *range = malloc(((size_t)tdims[0] + tdims[1] + tdims[2]) * 2 * sizeof *range);
+    if (!list || !range) {
+        free(list);
+        free(range);
+        return -1;
+    }
+    /* Brick ranges per axis and tile: range[2 (off[a] + t)] .. [+1]. */
+    int off[3] = {0, tdims[0], tdims[0] + tdims[1]};
+    for (int a = 0; a < 3; a++)
+        for (int t = 0; t < tdims[a]; t++) {
+            int v0 = (int)floor(4.0 * step * t), v1 = (int)floor(4.0 * step * (t + 1)) + 1;
+            v1 = v1 < f->dims[a] - 1 ? v1 : f->dims[a] - 1;
+            int b0 = v0 / SL_VOLUME_BRICK, b1 = v1 / SL_VOLUME_BRICK;
+            range[2 * (off[a] + t)] = b0 < b->dims[a] ? b0 : b->dims[a] - 1;
+            range[2 * (off[a] + t) + 1] = b1 < b->dims[a] ? b1 : b->dims[a] - 1;
+        }
+    uint32_t k = 0, t = 0;
+    for (int tz = 0; tz < tdims[2]; tz++)
+        for (int ty = 0; ty < tdims[1]; ty++)
+            for (int tx = 0; tx < tdims[0]; tx++, t++) {
+                const int *rx = range + 2 * (off[0] + tx), *ry = range + 2 * (off[1] + ty),
+                          *rz = range + 2 * (off[2] + tz);
+                int hit = 0;
+                for (int bz = rz[0]; bz <= rz[1] && !hit; bz++)
+                    for (int by = ry[0]; by <= ry[1] && !hit; by++)
+                        for (int bx = rx[0]; bx <= rx[1] && !hit; bx++)
+                            hit = mask[((size_t)bz * b->dims[1] + by) * b->dims[0] + bx];
+                if (hit)
+                    list[k++] = t;
+            }
+    free(range);
+    *out = list;
+    *count = k;
+    return 0;
+}
+
 /* Algorithm 1: count, allocate, emit (into particles[1], keys = edge ids,
- * values = slots). Returns the seed count in *count. */
-static sl_status place(pt_system *sys, const pt_field *f, const pt_system_desc *d, build_buffers *b,
-                       uint32_t *count, unsigned *id_bits, sl_err *err)
+ * values = slots). Returns the seed count in *count. With a brick mask
+ * (NULL: the whole lattice) only the tiles that may hold a crossing are
+ * dispatched: the same crossings, found at the same points. */
+static sl_status place(pt_system *sys, const pt_field *f, const pt_system_desc *d, const uint8_t *mask,
+                       build_buffers *b, pt_set_stats *stats, uint32_t *count, unsigned *id_bits, sl_err *err)
 {
     int ldims[3];
     uint64_t total = 1;
@@ -171,6 +257,20 @@ static sl_status place(pt_system *sys, const pt_field *f, const pt_system_desc *
     *id_bits = bits_for(total * 3 - 1);
     double gmin = 1e-6 * (f->value_max - f->value_min) / f->min_spacing;
     double sigma = d->sigma;
+    int tdims[3];
+    for (int a = 0; a < 3; a++)
+        tdims[a] = (ldims[a] + 3) / 4;
+    stats->tiles_total = (uint32_t)((uint64_t)tdims[0] * tdims[1] * tdims[2]);
+    stats->tiles = stats->tiles_total;
+    if (mask) {
+        uint32_t *list = NULL;
+        if (lattice_tiles(f, mask, d->lattice_step, tdims, &list, &stats->tiles) != 0)
+            return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the lattice tiles");
+        b->tiles = ssbo((size_t)stats->tiles * 4);
+        if (stats->tiles)
+            glNamedBufferSubData(b->tiles, 0, (GLsizeiptr)stats->tiles * 4, list);
+        free(list);
+    }
     b->counter = ssbo(sizeof(GLuint));
     for (int emit = 0; emit < 2; emit++) {
         GLuint p = sys->place[emit];
@@ -191,11 +291,22 @@ static sl_status place(pt_system *sys, const pt_field *f, const pt_system_desc *
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, b->values);
         }
         GLint first_loc = glGetUniformLocation(p, "u_first");
-        uint64_t per_chunk = (uint64_t)PT_MAX_GROUPS * 64;
-        for (uint64_t first = 0; first < total; first += per_chunk) {
-            uint64_t n = total - first < per_chunk ? total - first : per_chunk;
-            glUniform1ui(first_loc, (GLuint)first);
-            glDispatchCompute((GLuint)((n + 63) / 64), 1, 1);
+        glUniform1i(glGetUniformLocation(p, "u_tiled"), mask != NULL);
+        glUniform3ui(glGetUniformLocation(p, "u_tile_dims"), (GLuint)tdims[0], (GLuint)tdims[1], (GLuint)tdims[2]);
+        if (mask) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, b->tiles);
+            for (uint32_t first = 0; first < stats->tiles; first += PT_MAX_GROUPS) {
+                uint32_t n = stats->tiles - first < PT_MAX_GROUPS ? stats->tiles - first : PT_MAX_GROUPS;
+                glUniform1ui(first_loc, first);
+                glDispatchCompute(n, 1, 1);
+            }
+        } else {
+            uint64_t per_chunk = (uint64_t)PT_MAX_GROUPS * 64;
+            for (uint64_t first = 0; first < total; first += per_chunk) {
+                uint64_t n = total - first < per_chunk ? total - first : per_chunk;
+                glUniform1ui(first_loc, (GLuint)first);
+                glDispatchCompute((GLuint)((n + 63) / 64), 1, 1);
+            }
         }
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         GLuint n = 0;
@@ -303,8 +414,13 @@ static double energy_step(pt_system *sys, const pt_field *f, const pt_system_des
     return e;
 }
 
-/* Bins: cubes of side >= sigma over the volume box, at most PT_MAX_BINS. */
-static void choose_bins(const pt_field *f, double sigma, pt_set *s)
+/* Bins: cubes of side >= sigma over the volume box, at most PT_MAX_BINS;
+ * with a voxel box lo..hi of the bricks the surface may cross (NULL: none)
+ * only the bins within sigma of it are kept (u_bin_origin): the same bin
+ * size and alignment, so the bins keep their order (z, y, x) and a particle
+ * inside keeps its neighbours in the same order — the same particles, with
+ * fewer bins to count and scan. */
+static void choose_bins(const pt_field *f, double sigma, const int *lo, const int *hi, pt_set *s)
 {
     double ext[3], volume = 1.0;
     for (int a = 0; a < 3; a++) {
@@ -325,6 +441,19 @@ static void choose_bins(const pt_field *f, double sigma, pt_set *s)
         size *= 1.05;
     }
     s->bin_size = size;
+    if (!lo || lo[0] > hi[0])
+        return;
+    uint64_t bins = 1;
+    for (int a = 0; a < 3; a++) {
+        int b0 = (int)floor((lo[a] * f->spacing[a] - sigma) / size);
+        int b1 = (int)floor((hi[a] * f->spacing[a] + sigma) / size);
+        b0 = b0 > 0 ? b0 : 0;
+        b1 = b1 < s->bin_dims[a] - 1 ? b1 : s->bin_dims[a] - 1;
+        s->bin_origin[a] = b0;
+        s->bin_dims[a] = b1 - b0 + 1;
+        bins *= (uint64_t)s->bin_dims[a];
+    }
+    s->bins = (uint32_t)bins;
 }
 
 static void nn_statistics(const float *nn, uint32_t n, pt_set_stats *st)
@@ -350,12 +479,20 @@ sl_status pt_set_build(pt_system *sys, const pt_field *f, const pt_system_desc *
     float *group_sums = NULL, *nn = NULL;
     sl_status st = SL_OK;
     glBindTextureUnit(0, f->texture);
-    choose_bins(f, d->sigma, &s);
 
     double t0 = sl_clock_ms();
+    uint8_t *mask = NULL;
+    int lo[3], hi[3];
+    if (f->bricks && !d->no_skipping && !(mask = iso_bricks(f, d->iso, lo, hi))) {
+        st = sl_err_set(err, SL_ERR_NOMEM, "out of memory for the brick mask");
+        goto fail;
+    }
+    choose_bins(f, d->sigma, mask ? lo : NULL, mask ? hi : NULL, &s);
     uint32_t n = 0;
     unsigned id_bits = 1;
-    if ((st = place(sys, f, d, &b, &n, &id_bits, err)) != SL_OK)
+    st = place(sys, f, d, mask, &b, &s.stats, &n, &id_bits, err);
+    free(mask);
+    if (st != SL_OK)
         goto fail;
     s.stats.placement_ms = phase_end(t0);
     s.stats.seeded = n;

@@ -3,7 +3,10 @@
  * 4.1 and 4.2.3; README.md "The particle system").
  *
  * pt_set_build places particles on the isosurface f = iso of the trilinear
- * field (Algorithm 1 on a lattice of `lattice_step` voxels), sorts them by
+ * field (Algorithm 1 on a lattice of `lattice_step` voxels; with the
+ * field's min-max bricks only the lattice tiles of 4^3 points whose bricks
+ * may straddle iso are dispatched, and the bins cover only those bricks:
+ * the same particles, plan §1.1 "Skipping"), sorts them by
  * edge id (a deterministic order), runs up to max_steps energy steps
  * (keys -> sort by bin -> gather -> bin table -> energy step -> group sums
  * read back and added in double; stop when the relative energy change is
@@ -26,6 +29,7 @@
 #include <epoxy/gl.h>
 
 #include "../core/sl_status.h"
+#include "../volume/sl_volume.h"
 #include "particles_sort.h"
 
 /* The volume as the passes read it (a sl_volume_texture and its geometry). */
@@ -36,6 +40,7 @@ typedef struct pt_field {
     double spacing[3];            /* world units per voxel */
     double min_spacing;
     double value_min, value_max;  /* finite data range */
+    const sl_volume_bricks *bricks; /* borrowed min-max bricks of the same volume; NULL: no skipping */
 } pt_field;
 
 typedef struct pt_system_desc {
@@ -47,6 +52,8 @@ typedef struct pt_system_desc {
     pt_sort_method sort;
     pt_lookup_method lookup;
     uint32_t max_particles;       /* seeds above: SL_ERR_LIMIT */
+    int no_skipping;              /* 1: the whole lattice and bins over the whole volume box (same
+                                   * particles, for checks and benchmarks) */
 } pt_system_desc;
 
 typedef struct pt_set_stats {
@@ -58,6 +65,7 @@ typedef struct pt_set_stats {
     double mean_nn, nn_cv;        /* nearest-neighbour distance (world) over alive particles with one */
     double placement_ms, id_sort_ms, sort_ms, lookup_ms, gather_ms, energy_ms, settle_ms, final_ms;
     double ms_per_step;           /* keys + sort + gather + table + energy + read-back, per step */
+    uint32_t tiles, tiles_total;  /* lattice tiles of 4^3 points dispatched, of all */
 } pt_set_stats;
 
 typedef struct pt_set {
@@ -65,6 +73,7 @@ typedef struct pt_set {
     GLuint table;                 /* uint start[bins + 1] of the last sort */
     uint32_t count;               /* records held (alive + dead) */
     double bin_size;              /* world */
+    int bin_origin[3];            /* first bin of the grid over the volume box (see choose_bins) */
     int bin_dims[3];
     uint32_t bins;
     pt_set_stats stats;

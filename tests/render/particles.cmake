@@ -131,13 +131,14 @@ set_tests_properties(render.particles.curvature.detects_sign PROPERTIES DEPENDS 
 # parameters. Two runs give byte-equal exports; the two bin-table builds
 # give the same table, so byte-equal exports too; and since the bitonic sort
 # orders by (bin, previous index) exactly as the stable radix sort does, the
-# two sorts give byte-equal exports as well.
-foreach(variant a b bitonic binary_search)
+# two sorts give byte-equal exports as well. (The default look-up is
+# binary_search, so the variant sets the other one, prefix_sum.)
+foreach(variant a b bitonic prefix_sum)
   set(extra "")
   if(variant STREQUAL "bitonic")
     set(extra ",\"sort\":\"bitonic\"")
-  elseif(variant STREQUAL "binary_search")
-    set(extra ",\"lookup\":\"binary_search\"")
+  elseif(variant STREQUAL "prefix_sum")
+    set(extra ",\"lookup\":\"prefix_sum\"")
   endif()
   set(PT_DET_${variant} "${PT_RENDER}|--scene|${PT_BASE}|--set|dataset=${PT_TORUS64}|--set|params={\"isovalues\":[0]${extra}}|--out|${PT_OUT}/det_${variant}.png|--export|${PT_OUT}/det_${variant}.csv")
 endforeach()
@@ -146,9 +147,9 @@ pt_test(deterministic.runs ${CMAKE_COMMAND} "-DSTEP1=${PT_DET_a}" "-DSTEP2=${PT_
   "-DSTEP4=${CMAKE_COMMAND}|-E|compare_files|${PT_OUT}/det_a.png|${PT_OUT}/det_b.png"
   ${SL_STEPS})
 pt_test(deterministic.sorts_and_lookups ${CMAKE_COMMAND} "-DSTEP1=${PT_DET_a}" "-DSTEP2=${PT_DET_bitonic}"
-  "-DSTEP3=${PT_DET_binary_search}"
+  "-DSTEP3=${PT_DET_prefix_sum}"
   "-DSTEP4=${CMAKE_COMMAND}|-E|compare_files|${PT_OUT}/det_a.csv|${PT_OUT}/det_bitonic.csv"
-  "-DSTEP5=${CMAKE_COMMAND}|-E|compare_files|${PT_OUT}/det_a.csv|${PT_OUT}/det_binary_search.csv"
+  "-DSTEP5=${CMAKE_COMMAND}|-E|compare_files|${PT_OUT}/det_a.csv|${PT_OUT}/det_prefix_sum.csv"
   ${SL_STEPS})
 set_tests_properties(render.particles.deterministic.sorts_and_lookups PROPERTIES RESOURCE_LOCK particles_det)
 set_tests_properties(render.particles.deterministic.runs PROPERTIES RESOURCE_LOCK particles_det)
