@@ -139,6 +139,7 @@ static sl_status build(pt_hatch *h, pt_hatch_cache *c, const pt_set_view *sv, co
     set_field_uniforms(p, &h->field, iso);
     glUniform1f(glGetUniformLocation(p, "u_bin_size"), (float)set->bin_size);
     glUniform3i(glGetUniformLocation(p, "u_bin_dims"), set->bin_dims[0], set->bin_dims[1], set->bin_dims[2]);
+    glUniform3i(glGetUniformLocation(p, "u_bin_origin"), set->bin_origin[0], set->bin_origin[1], set->bin_origin[2]);
     glUniform1ui(glGetUniformLocation(p, "u_bins"), set->bins);
     glUniform1ui(glGetUniformLocation(p, "u_count"), n);
     glUniform1i(glGetUniformLocation(p, "u_mode"), key->mode);
