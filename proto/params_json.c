@@ -406,10 +406,9 @@ cJSON *sl_technique_json(const sl_technique *t)
     cJSON_AddStringToObject(o, "name", t->name);
     cJSON_AddStringToObject(o, "description", t->description);
     cJSON *kinds = cJSON_AddArrayToObject(o, "dataset_kinds");
-    const sl_dataset_kind all[] = {SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS};
-    for (int i = 0; i < 3; i++)
-        if (t->dataset_kinds & (unsigned)all[i])
-            cJSON_AddItemToArray(kinds, cJSON_CreateString(sl_dataset_kind_name(all[i])));
+    for (int i = 0; i < SL_DATASET_KIND_COUNT; i++)
+        if (t->dataset_kinds & (unsigned)sl_dataset_kinds[i])
+            cJSON_AddItemToArray(kinds, cJSON_CreateString(sl_dataset_kind_name(sl_dataset_kinds[i])));
     cJSON_AddItemToObject(o, "params", sl_params_schema_json(t->params, t->param_count));
     return o;
 }

@@ -481,10 +481,9 @@ sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t 
     } else {
         const char *k = (const char *)sqlite3_column_text(q, 0);
         *kind = 0;
-        const sl_dataset_kind kinds[] = {SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS};
-        for (int i = 0; i < 3; i++)
-            if (k && strcmp(k, sl_dataset_kind_name(kinds[i])) == 0)
-                *kind = kinds[i];
+        for (int i = 0; i < SL_DATASET_KIND_COUNT; i++)
+            if (k && strcmp(k, sl_dataset_kind_name(sl_dataset_kinds[i])) == 0)
+                *kind = sl_dataset_kinds[i];
         const char *path = (const char *)sqlite3_column_text(q, 1);
         const char *gen = (const char *)sqlite3_column_text(q, 2);
         *is_file = path != NULL;

@@ -472,8 +472,8 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
     if (!(t->dataset_kinds & (unsigned)next.dataset_kind)) {
         /* Refused whole: the session keeps its state (nothing below ran). */
         char kinds[64] = "";
-        const sl_dataset_kind all[] = {SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS};
-        for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        const sl_dataset_kind *all = sl_dataset_kinds;
+        for (size_t i = 0; i < SL_DATASET_KIND_COUNT; i++)
             if (t->dataset_kinds & (unsigned)all[i])
                 snprintf(kinds + strlen(kinds), sizeof kinds - strlen(kinds), "%s%s", kinds[0] ? ", " : "",
                          sl_dataset_kind_name(all[i]));

@@ -2,11 +2,16 @@
  * Any thread; no GL. */
 #include "sl_dataset.h"
 
+#include "../lrspline/sl_lr.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+const sl_dataset_kind sl_dataset_kinds[SL_DATASET_KIND_COUNT] = {
+    SL_DATASET_LINES, SL_DATASET_VOLUME, SL_DATASET_VECTORS, SL_DATASET_LR};
 
 sl_dataset *sl_dataset_create(sl_dataset_kind kind, const char *name)
 {
@@ -42,6 +47,10 @@ void sl_dataset_destroy(sl_dataset *ds)
     for (int i = 0; i < l->line_attribute_count; i++)
         free(l->line_attributes[i].values);
     free(ds->volume.data);
+    if (ds->lr) {
+        sl_lr_free(ds->lr);
+        free(ds->lr);
+    }
     free(ds);
 }
 
@@ -175,6 +184,7 @@ const char *sl_dataset_kind_name(sl_dataset_kind k)
     case SL_DATASET_LINES: return "lines";
     case SL_DATASET_VOLUME: return "volume";
     case SL_DATASET_VECTORS: return "vectors";
+    case SL_DATASET_LR: return "lr_volume";
     }
     return "unknown";
 }

@@ -1,7 +1,8 @@
 /* sl_dataset.h — the one in-memory model for every dataset Sightline renders.
  *
- * Three kinds: line sets (polylines), regular scalar volumes and regular
- * vector fields. Positions are float and relative to a double `origin`
+ * Four kinds: line sets (polylines), regular scalar volumes, regular
+ * vector fields and LR-spline volumes (scalar or vector; the model is in
+ * lrspline/sl_lr.h, held by pointer). Positions are float and relative to a double `origin`
  * (world = origin + stored), so data 1e5 units from the world origin keeps
  * float precision; loaders and generators set origin to the bounds centre
  * (sl_lines_recentre). Bounds are always world coordinates, in double.
@@ -29,7 +30,14 @@ typedef enum sl_dataset_kind {
     SL_DATASET_LINES = 1,
     SL_DATASET_VOLUME = 2,  /* scalar, 1 component */
     SL_DATASET_VECTORS = 4, /* f32 x 3 per voxel */
+    SL_DATASET_LR = 8,      /* LR-spline volume, dim 1 or 3 (sl_dataset.lr) */
 } sl_dataset_kind;
+
+/* Every kind, in enum order, for code that lists or names them all. */
+#define SL_DATASET_KIND_COUNT 4
+extern const sl_dataset_kind sl_dataset_kinds[SL_DATASET_KIND_COUNT];
+
+struct sl_lr_volume;
 
 /* A named float array: one value per vertex (line sets: vertex attributes),
  * or one per line (line attributes, e.g. TrackVis per-streamline properties). */
@@ -81,6 +89,8 @@ typedef struct sl_dataset {
     sl_vec3 bounds_min, bounds_max; /* world, including radii where given */
     sl_lines lines;          /* kind == SL_DATASET_LINES */
     sl_volume volume;        /* kind == SL_DATASET_VOLUME or SL_DATASET_VECTORS */
+    struct sl_lr_volume *lr; /* kind == SL_DATASET_LR: owned (sl_lr_free + free);
+                                origin = 0: the parameter domain is the world box */
     double load_ms;
     atomic_int extra_owners;  /* owners besides the creator (sl_dataset_retain) */
 } sl_dataset;
