@@ -27,6 +27,7 @@
 #include "data/sl_generate.h"
 #include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
+#include "lrspline/sl_lr.h"
 #include "volume/sl_volume.h"
 
 static const char *schema_sql =
@@ -133,6 +134,17 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
         cJSON_AddNumberToObject(c, "vertices", (double)ds->lines.vertex_count);
         for (int i = 0; i < ds->lines.attribute_count; i++)
             cJSON_AddItemToArray(a, cJSON_CreateString(ds->lines.attributes[i].name));
+    } else if (ds->kind == SL_DATASET_LR) {
+        /* No voxels, so no histogram; the value range is sl_lr_finish's sample. */
+        const sl_lr_volume *lr = ds->lr;
+        cJSON_AddNumberToObject(c, "elements", (double)lr->element_count);
+        cJSON_AddNumberToObject(c, "basis_functions", (double)lr->basis_count);
+        cJSON_AddNumberToObject(c, "components", lr->dim);
+        int degree[3] = {lr->order[0] - 1, lr->order[1] - 1, lr->order[2] - 1};
+        cJSON_AddItemToObject(c, "degree", cJSON_CreateIntArray(degree, 3));
+        double range[2] = {lr->value_min, lr->value_max};
+        if (isfinite(range[0]) && isfinite(range[1]))
+            cJSON_AddItemToObject(c, "value_range", cJSON_CreateDoubleArray(range, 2));
     } else {
         cJSON_AddItemToObject(c, "dims", cJSON_CreateIntArray(ds->volume.dims, 3));
         cJSON_AddNumberToObject(c, "components", ds->volume.components);
@@ -342,7 +354,8 @@ sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *ge
 
 static int known_extension(const char *name)
 {
-    static const char *const ext[] = {".trk", ".tck", ".vtk", ".obj", ".nrrd", ".nhdr", ".nii", ".nii.gz", ".json"};
+    static const char *const ext[] = {".trk", ".tck", ".vtk", ".obj", ".nrrd", ".nhdr", ".nii", ".nii.gz", ".json",
+                                      ".lr", ".lr.gz"};
     size_t len = strlen(name);
     for (size_t i = 0; i < sizeof ext / sizeof ext[0]; i++) {
         size_t el = strlen(ext[i]);

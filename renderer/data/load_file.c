@@ -1,4 +1,5 @@
-/* load_file.c — the loader table: picks a loader by file extension (sl_load.h).
+/* load_file.c — the loader table: picks a loader by file extension (sl_load.h),
+ * or for an unknown extension by the first bytes (the LR-spline header).
  *
  * sl_load_file reads the file (read_file.c: gunzip included) and hands the
  * bytes to the loader of its extension. Parses no format itself: a format
@@ -46,7 +47,11 @@ static const loader_entry loaders[] = {
     {".nhdr", sl_load_nrrd, sl_load_nrrd_content_size},
     {".nii", sl_load_nifti, sl_load_nifti_content_size},
     {".json", load_json_dataset, NULL},
+    {".lr", sl_load_lr, NULL},
 };
+
+/* Files of an unknown extension are recognised by their first bytes. */
+#define SNIFF_BYTES 256u
 
 /* Header bytes a content-size function may ask for before it must decide. */
 #define PROBE_START 4096u
@@ -56,7 +61,7 @@ static const loader_entry loaders[] = {
 /* ...or this much, whichever is larger. */
 #define GZ_FLOOR_BYTES (64ull * 1024ull * 1024ull)
 
-#define SL_SUPPORTED_EXTENSIONS ".trk .tck .vtk .obj .nrrd .nhdr .nii .nii.gz .json (each may also be gzipped as NAME.EXT.gz)"
+#define SL_SUPPORTED_EXTENSIONS ".trk .tck .vtk .obj .nrrd .nhdr .nii .nii.gz .json .lr (each may also be gzipped as NAME.EXT.gz; an LR-spline volume is also recognised by its header)"
 
 /* Loader for the file name, ignoring case and one trailing ".gz"; NULL when unknown. */
 static const loader_entry *loader_for(const char *path)
@@ -145,12 +150,33 @@ done:
     return st;
 }
 
+/* The loader whose header the file's first bytes (gunzipped) carry; NULL
+ * when none does or the file cannot be read (the caller reports it). */
+static const loader_entry *loader_by_content(const char *path)
+{
+    sl_load_stream *s = NULL;
+    sl_err ignored = {0};
+    if (sl_load_stream_open(path, SL_STREAM_AUTO, &s, &ignored) != SL_OK)
+        return NULL;
+    const uint8_t *p;
+    size_t n;
+    const loader_entry *found = NULL;
+    if (sl_load_stream_fill(s, SNIFF_BYTES, &p, &n, &ignored) == SL_OK && sl_load_lr_detect(p, n))
+        for (size_t k = 0; k < sizeof loaders / sizeof loaders[0]; k++)
+            if (loaders[k].fn == sl_load_lr)
+                found = &loaders[k];
+    sl_load_stream_close(s);
+    return found;
+}
+
 sl_status sl_load_file(const char *path, sl_dataset **out, sl_err *err)
 {
     *out = NULL;
     if (!path || !path[0])
         return sl_err_set(err, SL_ERR_INVALID, "sl_load_file: no path given");
     const loader_entry *entry = loader_for(path);
+    if (!entry)
+        entry = loader_by_content(path);
     if (!entry)
         return sl_err_set(err, SL_ERR_UNSUPPORTED, "%s: unknown file extension; supported: " SL_SUPPORTED_EXTENSIONS,
                           path);

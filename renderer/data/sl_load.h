@@ -53,6 +53,11 @@ int sl_hermite_json_detect(const struct cJSON *root); /* has "nodes" and "segmen
 sl_status sl_load_nrrd(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* .nrrd and .nhdr */
 sl_status sl_load_nifti(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* .nii (gunzipped by the caller for .nii.gz) */
 sl_status sl_load_raw_json(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err); /* the JSON sidecar; the raw file beside it */
+/* LR-spline volumes: the SINTEF LRsplines text format (.lr; .lr.gz gunzipped
+ * by the caller), scalar or vector, polynomial, degree <= 3 (load_lr.c). */
+sl_status sl_load_lr(const uint8_t *data, size_t size, const char *path, sl_dataset **out, sl_err *err);
+/* 1 when the bytes start (after whitespace) with the LRsplines volume header "# LRSPLINE VOLUME". */
+int sl_load_lr_detect(const uint8_t *data, size_t size);
 
 /* Reads a whole file (gunzipping when it starts with the gzip magic) into a
  * malloc'd buffer, refusing more than `limit` bytes. */
@@ -62,7 +67,8 @@ sl_status sl_read_file(const char *path, uint64_t limit, uint8_t **data, size_t 
 sl_status sl_gunzip(const uint8_t *data, size_t size, uint64_t limit, uint8_t **out, size_t *out_size, sl_err *err);
 
 /* Picks the loader from the file name (.trk .tck .vtk .obj .nrrd .nhdr .nii
- * .nii.gz .json), reads the file and loads it. The dataset's name is the
+ * .nii.gz .json .lr .lr.gz), reads the file and loads it; a file of another
+ * extension whose content starts with "# LRSPLINE VOLUME" is read as .lr. The dataset's name is the
  * file's base name. NIfTI and NRRD files are read (and inflated) only as
  * far as their header says; other gzipped files may inflate to at most
  * max(64 MiB, 64 x their compressed size) (SL_ERR_LIMIT beyond). */
