@@ -4,7 +4,9 @@
  * '{"generator":"tornado","lines":100}' or a built-in dataset name
  * (renderer/data/sl_generate.h), and prints one JSON object on stdout: kind,
  * name, counts, world bounds, origin, attributes with their ranges (lines) or
- * dims, voxel type, spacing, value range and NaN voxels (volumes), and load_ms.
+ * dims, voxel type, spacing, value range and NaN voxels (volumes), degree,
+ * dim, element / basis / mesh-rectangle counts, refinement levels, domain and
+ * the sampled value range (LR-spline volumes), and load_ms.
  * `sightline-info --list` prints the generator families and built-ins.
  * Does no loading or generating itself. Single-threaded.
  * Exit status: 0 success; 1 usage error (usage on stderr); 2 bad input, with
@@ -19,6 +21,7 @@
 #include "data/sl_dataset.h"
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
+#include "lrspline/sl_lr.h"
 
 #define EXIT_USAGE 1
 #define EXIT_BAD_INPUT 2
@@ -29,7 +32,9 @@ static void usage(FILE *f)
             "usage: sightline-info FILE | GENERATOR-JSON | BUILTIN-NAME\n"
             "       sightline-info --list\n"
             "Prints a JSON description of the dataset (counts, bounds, attributes,\n"
-            "volume dims and value range, load_ms). Exit 0 ok, 1 usage, 2 bad input.\n");
+            "volume dims and value range; LR-spline degree, elements, basis functions,\n"
+            "refinement levels, domain and sampled value range; load_ms).\n"
+            "Exit 0 ok, 1 usage, 2 bad input.\n");
 }
 
 static cJSON *vec3_json(sl_vec3 v)
@@ -88,6 +93,30 @@ static void add_volume(cJSON *root, const sl_volume *v)
     cJSON_AddItemToObject(root, "value_range", cJSON_CreateDoubleArray(range, 2));
 }
 
+/* LR-spline volumes: the value range is sl_lr_finish's sample (element
+ * corners, edge and face midpoints, centres), not a bound. */
+static void add_lr(cJSON *root, const sl_lr_volume *lr)
+{
+    int degree[3] = {lr->order[0] - 1, lr->order[1] - 1, lr->order[2] - 1};
+    cJSON_AddItemToObject(root, "degree", cJSON_CreateIntArray(degree, 3));
+    cJSON_AddNumberToObject(root, "components", lr->dim);
+    cJSON *counts = cJSON_AddObjectToObject(root, "counts");
+    cJSON_AddNumberToObject(counts, "elements", (double)lr->element_count);
+    cJSON_AddNumberToObject(counts, "basis_functions", (double)lr->basis_count);
+    cJSON_AddNumberToObject(counts, "mesh_rectangles", (double)lr->meshrect_count);
+    cJSON_AddNumberToObject(root, "refinement_levels", sl_lr_level_ratio(lr));
+    cJSON_AddItemToObject(root, "min_element_side", cJSON_CreateDoubleArray(lr->min_side, 3));
+    cJSON_AddItemToObject(root, "max_element_side", cJSON_CreateDoubleArray(lr->max_side, 3));
+    cJSON *domain = cJSON_AddObjectToObject(root, "domain");
+    cJSON_AddItemToObject(domain, "min", cJSON_CreateDoubleArray(lr->domain_lo, 3));
+    cJSON_AddItemToObject(domain, "max", cJSON_CreateDoubleArray(lr->domain_hi, 3));
+    const double range[2] = {lr->value_min, lr->value_max};
+    cJSON_AddItemToObject(root, "value_range", cJSON_CreateDoubleArray(range, 2));
+    cJSON_AddStringToObject(root, "value_range_note",
+                            lr->dim == 3 ? "sampled (vector magnitude at 27 points per element), not a bound"
+                                         : "sampled (27 points per element), not a bound");
+}
+
 static cJSON *dataset_json(const sl_dataset *ds)
 {
     cJSON *root = cJSON_CreateObject();
@@ -95,6 +124,8 @@ static cJSON *dataset_json(const sl_dataset *ds)
     cJSON_AddStringToObject(root, "name", ds->name);
     if (ds->kind == SL_DATASET_LINES)
         add_lines(root, &ds->lines);
+    else if (ds->kind == SL_DATASET_LR)
+        add_lr(root, ds->lr);
     else
         add_volume(root, &ds->volume);
     cJSON *bounds = cJSON_AddObjectToObject(root, "bounds");

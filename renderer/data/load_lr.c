@@ -255,13 +255,14 @@ static sl_status record_start(lr_cursor *c, char want, size_t i, size_t count, s
 {
     skip_comments(c);
     const char *plural = want == 'b' ? "basis functions" : want == 'r' ? "mesh rectangles" : "elements";
+    const char *one = want == 'b' ? "basis function" : want == 'r' ? "mesh rectangle" : "element";
     if (c->pos >= c->n)
         return sl_err_set(err, SL_ERR_FORMAT, "the file ends after %zu of the %zu %s the header announces"
                           " (truncated, or a lying count)", i, count, plural);
     char k = record_kind(c);
     if (k != want)
         return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s where %s %zu of %zu was expected (the header's"
-                          " counts do not match the records)", c->line, record_name(k), plural, i + 1, count);
+                          " counts do not match the records)", c->line, record_name(k), one, i + 1, count);
     return SL_OK;
 }
 

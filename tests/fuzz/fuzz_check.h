@@ -8,7 +8,10 @@
  * attribute value is read (so ASan sees the whole arrays); attribute ranges
  * are ordered. A volume has dims >= 1 within SL_MAX_VOXELS, 1 or 3
  * components, an ordered value range, positive spacing, and every voxel is
- * read. Violations abort(); the dataset is destroyed. Single-threaded;
+ * read. An LR-spline volume (fuzz_lr.c) has a finished model whose element
+ * lists index existing basis functions, a finite domain equal to the
+ * bounds, an ordered value range, and a finite value at every element's
+ * centre. Violations abort(); the dataset is destroyed. Single-threaded;
  * test-only.
  */
 #ifndef SL_FUZZ_CHECK_H
@@ -19,6 +22,34 @@
 #include <stdlib.h>
 
 #include "data/sl_load.h"
+#include "lrspline/sl_lr.h"
+
+/* The LR branch of sl_fuzz_check. */
+static inline void sl_fuzz_check_lr(const sl_dataset *ds)
+{
+    const sl_lr_volume *lr = ds->lr;
+    if (!lr || lr->element_count == 0 || lr->basis_count == 0 || (lr->dim != 1 && lr->dim != 3) ||
+        !(lr->value_min <= lr->value_max) || ds->bounds_min.x != lr->domain_lo[0] ||
+        ds->bounds_max.z != lr->domain_hi[2])
+        abort();
+    for (size_t i = 0; i < lr->element_count; i++) {
+        const sl_lr_element *e = &lr->elements[i];
+        if ((size_t)e->basis_offset + e->basis_count > lr->element_basis_count)
+            abort();
+        for (uint32_t k = 0; k < e->basis_count; k++)
+            if (lr->element_basis[e->basis_offset + k] >= lr->basis_count)
+                abort();
+        double p[3], v[SL_LR_MAX_DIM], g[3 * SL_LR_MAX_DIM];
+        for (int d = 0; d < 3; d++)
+            p[d] = 0.5 * (e->lo[d] + e->hi[d]);
+        sl_err err = {0};
+        if (sl_lr_eval(lr, p, (long)i, v, g, &err) != SL_OK)
+            abort();
+        for (int c = 0; c < lr->dim; c++)
+            if (!isfinite(v[c]))
+                abort();
+    }
+}
 
 static inline void sl_fuzz_check(sl_status st, sl_dataset *ds, const sl_err *err)
 {
@@ -62,6 +93,8 @@ static inline void sl_fuzz_check(sl_status st, sl_dataset *ds, const sl_err *err
                       ds->bounds_max.y + ds->bounds_max.z) ||
             !(ds->bounds_min.x <= ds->bounds_max.x))
             abort();
+    } else if (ds->kind == SL_DATASET_LR) {
+        sl_fuzz_check_lr(ds);
     } else {
         const sl_volume *v = &ds->volume;
         if ((ds->kind != SL_DATASET_VOLUME && ds->kind != SL_DATASET_VECTORS) || !v->data ||

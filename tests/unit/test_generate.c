@@ -1243,6 +1243,30 @@ static void test_info_tool(void)
         free(out);
         unlink(path);
     }
+    /* An LR-spline volume (the loader's seed file: one element of a 2x2x1 mesh split at u = 0.5). */
+    rc = run_info("tests/fuzz/corpus/lr/refined.lr", &out);
+    root = rc == 0 && out ? cJSON_Parse(out) : NULL;
+    SL_CHECK_MSG(root != NULL, "sightline-info refined.lr: exit %d", rc);
+    if (root) {
+        cJSON *degree = cJSON_GetObjectItem(root, "degree"), *counts = cJSON_GetObjectItem(root, "counts");
+        SL_CHECK(strcmp(cJSON_GetObjectItem(root, "kind")->valuestring, "lr_volume") == 0);
+        SL_CHECK(cJSON_GetArraySize(degree) == 3 && cJSON_GetArrayItem(degree, 0)->valueint == 2 &&
+                 cJSON_GetArrayItem(degree, 1)->valueint == 1 && cJSON_GetArrayItem(degree, 2)->valueint == 0);
+        SL_CHECK(cJSON_GetObjectItem(root, "components")->valueint == 1);
+        SL_CHECK(cJSON_GetObjectItem(counts, "elements")->valuedouble == 5 &&
+                 cJSON_GetObjectItem(counts, "basis_functions")->valuedouble == 13 &&
+                 cJSON_GetObjectItem(counts, "mesh_rectangles")->valuedouble == 9);
+        SL_CHECK(cJSON_GetObjectItem(root, "refinement_levels")->valuedouble == 2.0); /* u sides 1/2 and 1 */
+        cJSON *dmax = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "domain"), "max");
+        SL_CHECK(cJSON_GetArraySize(dmax) == 3 && cJSON_GetArrayItem(dmax, 0)->valuedouble == 2.0 &&
+                 cJSON_GetArrayItem(dmax, 2)->valuedouble == 1.0);
+        cJSON *range = cJSON_GetObjectItem(root, "value_range");
+        SL_CHECK(cJSON_GetArraySize(range) == 2 &&
+                 cJSON_GetArrayItem(range, 0)->valuedouble < cJSON_GetArrayItem(range, 1)->valuedouble);
+        SL_CHECK(strstr(cJSON_GetObjectItem(root, "value_range_note")->valuestring, "sampled") != NULL);
+        cJSON_Delete(root);
+    }
+    free(out);
     rc = run_info(NULL, &out);
     SL_CHECK_MSG(rc == 1, "no argument: exit %d, want 1", rc);
     free(out);

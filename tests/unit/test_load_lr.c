@@ -228,15 +228,15 @@ static void test_counts_and_header(void)
     const char *good = refined_text();
     char *t = replace(good, "\t3\t2\t1\t13\t9\t5\t1\t0", "\t3\t2\t1\t14\t9\t5\t1\t0");
     expect_refused("one basis function more announced", t, SL_ERR_FORMAT,
-                   "a mesh rectangle where basis functions 14 of 14 was expected");
+                   "a mesh rectangle where basis function 14 of 14 was expected");
     free(t);
     t = replace(good, "\t3\t2\t1\t13\t9\t5\t1\t0", "\t3\t2\t1\t12\t9\t5\t1\t0");
     expect_refused("one basis function fewer announced", t, SL_ERR_FORMAT,
-                   "a basis function where mesh rectangles 1 of 9 was expected");
+                   "a basis function where mesh rectangle 1 of 9 was expected");
     free(t);
     t = replace(good, "\t3\t2\t1\t13\t9\t5\t1\t0", "\t3\t2\t1\t13\t10\t5\t1\t0");
     expect_refused("one mesh rectangle more announced", t, SL_ERR_FORMAT,
-                   "an element where mesh rectangles 10 of 10 was expected");
+                   "an element where mesh rectangle 10 of 10 was expected");
     free(t);
     t = replace(good, "\t3\t2\t1\t13\t9\t5\t1\t0", "\t3\t2\t1\t13\t9\t6\t1\t0");
     expect_refused("one element more announced", t, SL_ERR_FORMAT, "ends after 5 of the 6 elements");
