@@ -4,7 +4,8 @@
  * added (exit 0) and listed with its kind and dims; adding it again, adding
  * a file outside the data directory, and adding one through a symlink that
  * leaves it are refused (non-zero exit, nothing listed); scan registers the
- * files it can load and skips the rest; remove deletes exactly one name and
+ * files it can load (an LR-spline volume among them, listed as lr_volume
+ * with its element and basis counts) and skips the rest; remove deletes exactly one name and
  * refuses an unknown one; add-generator validates its JSON; names with SQL
  * quotes are data, not SQL (bound parameters); the database is in WAL mode
  * (a -wal file exists while the server holds it); bad server arguments exit 2.
@@ -121,10 +122,24 @@ int main(void)
         fputs("not a nrrd file\n", f);
         fclose(f);
     }
+    /* An LR-spline volume (the loader's seed file) is scanned too and listed as lr_volume. */
+    char lr_path[400];
+    snprintf(lr_path, sizeof lr_path, "%s/refined.lr", data);
+    FILE *src = fopen("tests/fuzz/corpus/lr/refined.lr", "rb"), *dst = fopen(lr_path, "wb");
+    SL_CHECK(src && dst);
+    for (int ch; src && dst && (ch = fgetc(src)) != EOF;)
+        fputc(ch, dst);
+    if (src)
+        fclose(src);
+    if (dst)
+        fclose(dst);
     const char *scan[] = {"catalog", "scan", data, NULL};
     SL_CHECK(run(NULL, scan) == 0);
     SL_CHECK(strstr(list(), "second.nrrd") != NULL && strstr(listing, "junk.nrrd") == NULL &&
              strstr(listing, "link.nrrd") == NULL);
+    SL_CHECK_MSG(strstr(listing, "refined.lr") && strstr(listing, "lr_volume") &&
+                 strstr(listing, "\"elements\":5") && strstr(listing, "\"basis_functions\":13"),
+                 "LR volume not listed: %.2000s", listing);
     const char *scan_out[] = {"catalog", "scan", "/etc", NULL};
     SL_CHECK(run(NULL, scan_out) != 0);
 
