@@ -8,7 +8,9 @@
  * lr_test_text.h compared against sl_lr_tensor_product on the same knots and
  * coefficients (value and gradient to 1e-12); and a hand-written locally
  * refined file (one element of a 2x2x1 mesh split, coefficients by Boehm's
- * knot insertion) that must equal the unrefined tensor spline (1e-12).
+ * knot insertion) that must equal the unrefined tensor spline (1e-12); and
+ * tests/data/lr/two_lines.lr (two partial mesh lines, scaling weights 7/16,
+ * made by make_two_lines.py), equal to its tensor spline to 1e-12.
  * Hostile files: lying counts both ways, knots out of order, a basis id out
  * of range or listed twice, an element no listed basis covers, wrong ids,
  * truncation (every prefix of a small file), a truncated gzip, rat = 1,
@@ -404,6 +406,52 @@ static void test_tensor(int dim)
     free(text);
 }
 
+/* ---- two partial mesh lines: scaling weights 7/16 (tests/data/lr/make_two_lines.py) ---- */
+
+static void two_lines_coef(void *user, const int ijk[3], const double g[3], double *coef)
+{
+    (void)user;
+    (void)g;
+    int i = ijk[0], j = ijk[1];
+    coef[0] = 1.0 + 0.5 * i - 0.25 * j + 0.125 * i * j + (i == 2 && j == 1 ? 0.3 : 0.0);
+}
+
+static void test_two_lines(void)
+{
+    sl_dataset *ds = NULL;
+    sl_err err = {0};
+    sl_status st = sl_load_file("tests/data/lr/two_lines.lr", &ds, &err);
+    SL_CHECK_MSG(st == SL_OK, "two_lines.lr: %s", err.message);
+    if (!ds)
+        return;
+    const sl_lr_volume *lr = ds->lr;
+    SL_CHECK(lr->basis_count == 30 && lr->element_count == 14);
+    int weighted = 0;
+    for (size_t i = 0; i < lr->basis_count; i++)
+        weighted += lr->basis[i].gamma == 0.4375;
+    SL_CHECK_MSG(weighted > 0, "no scaling weight 7/16");
+    const double k[] = {0, 0, 0, 1, 2, 3, 3, 3}, kw[] = {0, 1};
+    const double *knots[3] = {k, k, kw};
+    const int order[3] = {3, 3, 1}, count[3] = {8, 8, 2};
+    sl_lr_volume ref;
+    st = sl_lr_tensor_product(&ref, order, 1, knots, count, two_lines_coef, NULL, &err);
+    SL_CHECK_MSG(st == SL_OK, "tensor: %s", err.message);
+    double worst = 0;
+    for (int s = 0; s < 4000 && st == SL_OK; s++) {
+        double p[3] = {3 * frand(), 3 * frand(), frand()}, a, b, ga[3], gb[3];
+        if (s % 50 == 0)
+            p[s % 100 ? 0 : 1] = 1.5; /* on a new mesh line */
+        SL_CHECK(sl_lr_eval(lr, p, -1, &a, ga, &err) == SL_OK && sl_lr_eval(&ref, p, -1, &b, gb, &err) == SL_OK);
+        worst = fmax(worst, fabs(a - b));
+        for (int j = 0; j < 3; j++)
+            worst = fmax(worst, fabs(ga[j] - gb[j]));
+    }
+    SL_CHECK_MSG(worst <= 1e-12, "two_lines vs its tensor spline: %.3g", worst);
+    if (st == SL_OK)
+        sl_lr_free(&ref);
+    sl_dataset_destroy(ds);
+}
+
 /* ---- the reference library's file ---- */
 
 static void test_reference_fixture(void)
@@ -452,6 +500,7 @@ int main(void)
     test_counts_and_header();
     test_tensor(1);
     test_tensor(3);
+    test_two_lines();
     test_reference_fixture();
     const char *names[] = {"tensor.lr", "tensor.spline", "tensor.lr.gz", "cut.lr.gz"};
     for (int i = 0; i < 4; i++) {
