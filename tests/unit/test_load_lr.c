@@ -438,7 +438,7 @@ static void test_two_lines(void)
     SL_CHECK_MSG(st == SL_OK, "tensor: %s", err.message);
     double worst = 0;
     for (int s = 0; s < 4000 && st == SL_OK; s++) {
-        double p[3] = {3 * frand(), 3 * frand(), frand()}, a, b, ga[3], gb[3];
+        double p[3] = {3 * frand(), 3 * frand(), frand()}, a = 0, b = 0, ga[3] = {0}, gb[3] = {0};
         if (s % 50 == 0)
             p[s % 100 ? 0 : 1] = 1.5; /* on a new mesh line */
         SL_CHECK(sl_lr_eval(lr, p, -1, &a, ga, &err) == SL_OK && sl_lr_eval(&ref, p, -1, &b, gb, &err) == SL_OK);
