@@ -1,29 +1,18 @@
-/* load_lr.c — SINTEF LRsplines text volumes (.lr; .lr.gz arrives here
- * gunzipped) into an SL_DATASET_LR dataset (model: lrspline/sl_lr.h).
+/* load_lr.c — SINTEF LRsplines text volumes (.lr; .lr.gz arrives gunzipped)
+ * into an SL_DATASET_LR dataset (model: lrspline/sl_lr.h).
  *
- * Layout, as LR::LRSplineVolume::write writes it and ::read reads it
- * (github.com/VikingScientist/LRsplines, src/LRSplineVolume.cpp,
- * Basisfunction.cpp, MeshRectangle.cpp, Element.cpp):
- *   # LRSPLINE VOLUME
- *   #  p1 p2 p3 Nbasis Nline Nel dim rat        (p = order = degree + 1)
- *      3  3  3  ...
- *   # Basis functions:
- *   0: [0 0 0 1 ] x [0 0 1 2 ] x [0 1 2 3 ] c_1 .. c_dim (gamma)
- *   # Mesh rectangles:
- *   [0, 0] x [0, 4] x [0, 5] (3)
- *   # Elements:
- *   0 [3] : (0, 0, 0) x (1, 1, 1)    {0, 1, 2}
- * Whitespace (spaces, tabs, newlines) is free between tokens, as the
- * reference reader's ws() makes it; lines starting with '#' are comments
- * between records. Basis and element ids must be their position (0..N-1):
- * the writer numbers them so and element lists index basis functions by
- * position. Refused: a header other than "# LRSPLINE VOLUME" (surfaces),
- * rat = 1 and orders above 4 (SL_ERR_UNSUPPORTED), counts above the limits
- * of sl_lr.h (SL_ERR_LIMIT), counts the bytes cannot hold, fewer or more
- * records than announced, a second patch, and every malformed record, by
- * line number; sl_lr_finish then checks the model (coverage, partition of
- * unity, no gap or overlap). Two passes (check and count, then fill exact
- * arrays), so allocation follows the bytes present. Any thread; no GL.
+ * The layout is LR::LRSplineVolume::write's (VikingScientist/LRsplines:
+ * LRSplineVolume.cpp, Basisfunction.cpp, MeshRectangle.cpp, Element.cpp;
+ * summarised in proto/scene.md): "# LRSPLINE VOLUME", the line p1 p2 p3
+ * Nbasis Nline Nel dim rat, then the records. Whitespace between tokens is
+ * free (the reference reader's ws()); '#' lines are comments between
+ * records; basis and element ids must be their position 0..N-1 (the
+ * writer's numbering, which element lists index). Refused, by line number:
+ * surfaces, rat = 1 and orders above 4 (SL_ERR_UNSUPPORTED), counts above
+ * sl_lr.h's limits or beyond what the bytes can hold (before allocating),
+ * fewer or more records than announced, a second patch, malformed records;
+ * sl_lr_finish then checks coverage, partition of unity, gaps and overlaps.
+ * Two passes (check and count, then fill exact arrays). Any thread; no GL.
  */
 #include "load_common.h"
 

@@ -1,21 +1,16 @@
-/* sl_probe.h — the value (and gradient) of a dataset's field at world
- * points, evaluated on the CPU in double: what `sightline-probe` answers and
- * the reference a GPU evaluation is compared against.
+/* sl_probe.h — a dataset's field (value, gradient) at world points, on the
+ * CPU in double: what `sightline-probe` answers, and the reference a GPU
+ * evaluation is compared against.
  *
- * Regular scalar volumes and vector fields: the trilinear interpolant of
- * the voxel values, voxel (i,j,k) at origin + spacing·(i,j,k) (the
- * convention of renderer/volume/sl_volume.h); the domain is the box of the
- * voxel centres, closed, except that an axis of one voxel is a slab one
- * spacing thick on which the value is constant. The gradient is the
- * interpolant's own (per world unit; in a cell's interior exact, on a cell
- * face the cell above, at the last voxel the cell below; 0 along a
- * one-voxel axis). Taps of zero weight are not read, so a point on a voxel
- * gives that voxel's value even beside a NaN voxel.
- * LR-spline volumes: sl_lr_eval on the element the element rule of
- * lrspline/sl_lr.h picks (linear search); the domain is the closed
- * parameter box.
- * Line sets have no field: SL_ERR_UNSUPPORTED. Does not do GPU evaluation
- * (another backend with the same shape, see tools/sightline_probe.c).
+ * Regular volumes and vector fields: the trilinear interpolant, voxel
+ * (i,j,k) at origin + spacing·(i,j,k) (renderer/volume/sl_volume.h); the
+ * domain is the closed box of the voxel centres, a one-voxel axis a slab one
+ * spacing thick with a constant value. The gradient is the interpolant's own
+ * (on a cell face the cell above, at the last voxel the cell below; 0 along a
+ * one-voxel axis); taps of zero weight are not read (a NaN neighbour does not
+ * reach a probe on a voxel). LR-spline volumes: sl_lr_eval on the element the
+ * rule of lrspline/sl_lr.h picks (linear search). Line sets have no field.
+ * No GPU path here (tools/sightline_probe.c has the backend seam for one).
  * Any thread; the dataset is only read.
  */
 #ifndef SL_PROBE_H
