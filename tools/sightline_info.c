@@ -113,8 +113,8 @@ static void add_lr(cJSON *root, const sl_lr_volume *lr)
     const double range[2] = {lr->value_min, lr->value_max};
     cJSON_AddItemToObject(root, "value_range", cJSON_CreateDoubleArray(range, 2));
     cJSON_AddStringToObject(root, "value_range_note",
-                            lr->dim == 3 ? "sampled (vector magnitude at 27 points per element), not a bound"
-                                         : "sampled (27 points per element), not a bound");
+                            lr->dim == 3 ? "sampled (vector magnitude at each element's 8 corners and centre), not a bound"
+                                         : "sampled (each element's 8 corners and centre), not a bound");
 }
 
 static cJSON *dataset_json(const sl_dataset *ds)

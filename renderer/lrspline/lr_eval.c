@@ -28,7 +28,7 @@ void sl_lr_bspline_piece(const double *t, int order, double a, double b, double 
     n[span] = 1.0;
     int degree = order - 1;
     for (int k = 1; k <= degree; k++) {
-        for (int j = 0; j <= order; j++)
+        for (int j = 0; j + k <= order; j++)
             prev[j] = n[j];
         for (int j = 0; j + k < order; j++) {
             double left = 0.0, right = 0.0;
@@ -39,8 +39,6 @@ void sl_lr_bspline_piece(const double *t, int order, double a, double b, double 
                 right = (t[j + k + 1] - x) / dr * prev[j + 1];
             n[j] = left + right;
         }
-        for (int j = order - k; j <= order; j++)
-            n[j] = 0.0;
     }
     *value = n[0];
     if (degree >= 1) {

@@ -183,15 +183,14 @@ sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err)
     lr->value_max = -DBL_MAX;
     for (size_t i = 0; i < lr->element_count; i++) {
         const sl_lr_element *e = &lr->elements[i];
-        for (int a = 0; a < 27; a++) {
+        for (int a = 0; a < 9; a++) {
             double p[3], v[SL_LR_MAX_DIM];
-            int f[3] = {a % 3, (a / 3) % 3, a / 9};
             for (int d = 0; d < 3; d++)
-                p[d] = e->lo[d] + 0.5 * f[d] * (e->hi[d] - e->lo[d]);
+                p[d] = a == 8 ? 0.5 * (e->lo[d] + e->hi[d]) : (a >> d & 1) ? e->hi[d] : e->lo[d];
             sl_status st = sl_lr_eval(lr, p, (long)i, v, NULL, err);
             if (st != SL_OK)
                 return st;
-            if (a == 13) {
+            if (a == 8) {
                 /* The centre: the scaled basis must be a partition of unity. */
                 double sum = 0.0;
                 for (uint32_t k = 0; k < e->basis_count; k++) {

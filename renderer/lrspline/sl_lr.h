@@ -90,8 +90,8 @@ void sl_lr_free(sl_lr_volume *lr);
  * function's support; a basis id out of range; element basis lists that
  * overrun element_basis; elements whose volumes do not add up to the domain
  * box (relative 1e-9, so no gap or overlap). value_min/max are taken over the
- * values at every element's 3x3x3 lattice of corners, face and edge midpoints
- * and centre (a sample, not a bound; sl_lr_bezier gives the hull bound). */
+ * values at every element's 8 corners and centre (a sample, not a bound; the
+ * Bézier blocks give the hull bound). */
 sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err);
 
 /* Index of the element containing p under the element rule, by a linear
