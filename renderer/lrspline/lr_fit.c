@@ -614,7 +614,7 @@ knots_done:
         if ((st = copy_model(out, &prev, err)) != SL_OK)
             break;
         double tr = now_seconds();
-        if ((st = sl_lr_refine_basis(out, ids, take, min_span, NULL, err)) != SL_OK)
+        if ((st = sl_lr_refine_basis(out, ids, take, min_span, 0, NULL, err)) != SL_OK)
             break;
         refine_seconds = now_seconds() - tr;
         if (out->basis_count > p->max_basis) {

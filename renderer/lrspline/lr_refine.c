@@ -540,7 +540,7 @@ static sl_status check_rect(const sl_lr_volume *lr, const sl_lr_meshrect *m, siz
     return SL_OK;
 }
 
-sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, sl_err *err)
+static sl_status refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, int check, sl_err *err)
 {
     work w;
     memset(&w, 0, sizeof w);
@@ -759,11 +759,28 @@ sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, 
         sl_lr_element *x = &out.elements[w.pairs[p]];
         out.element_basis[x->basis_offset + x->basis_count++] = w.pairs[p + 1];
     }
-    st = sl_lr_finish(&out, err);
-    if (st != SL_OK) {
-        sl_err_prefix(err, "after refinement: ");
-        sl_lr_free(&out);
-        goto out;
+    if (check) {
+        st = sl_lr_finish(&out, err);
+        if (st != SL_OK) {
+            sl_err_prefix(err, "after refinement: ");
+            sl_lr_free(&out);
+            goto out;
+        }
+    } else {
+        /* The geometry sl_lr_finish would derive; the value range stays stale. */
+        memcpy(out.domain_lo, lr->domain_lo, sizeof out.domain_lo);
+        memcpy(out.domain_hi, lr->domain_hi, sizeof out.domain_hi);
+        out.value_min = lr->value_min;
+        out.value_max = lr->value_max;
+        for (int d = 0; d < 3; d++) {
+            out.min_side[d] = INFINITY;
+            out.max_side[d] = 0.0;
+            for (size_t e = 0; e < out.element_count; e++) {
+                double side = out.elements[e].hi[d] - out.elements[e].lo[d];
+                out.min_side[d] = fmin(out.min_side[d], side);
+                out.max_side[d] = fmax(out.max_side[d], side);
+            }
+        }
     }
     sl_lr_free(lr);
     *lr = out;
@@ -775,7 +792,12 @@ out:
     return st;
 }
 
-sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3],
+sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, sl_err *err)
+{
+    return refine(lr, rects, n, 1, err);
+}
+
+sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3], int check,
                              size_t *inserted, sl_err *err)
 {
     sl_lr_meshrect *r = NULL;
@@ -801,7 +823,7 @@ sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, co
                 m->multiplicity = 1;
             }
     }
-    sl_status st = count ? sl_lr_refine(lr, r, count, err) : SL_OK;
+    sl_status st = count ? refine(lr, r, count, check, err) : SL_OK;
     free(r);
     if (inserted)
         *inserted = st == SL_OK ? count : 0;

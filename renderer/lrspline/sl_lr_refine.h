@@ -37,9 +37,12 @@ sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, 
 /* "Structured" refinement (Johannessen et al., section 5): for each listed
  * basis function, the planes halving each of its knot spans longer than
  * min_span[d] (per direction; 0 for no limit), over its whole support, are
- * inserted with sl_lr_refine. *inserted (may be NULL) gets the number of
- * rectangles; 0 means nothing could be refined. */
-sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3],
+ * inserted as sl_lr_refine does. *inserted (may be NULL) gets the number of
+ * rectangles; 0 means nothing could be refined. check = 0 skips the final
+ * sl_lr_finish (its cost dominates a refinement step): the geometry fields
+ * are still set, value_min/max are left as they were, and the caller must
+ * run sl_lr_finish before the model is used (sl_lr_fit does, at its end). */
+sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3], int check,
                              size_t *inserted, sl_err *err);
 
 #endif
