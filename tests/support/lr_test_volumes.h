@@ -149,15 +149,15 @@ static inline int lrt_refine_box(lrt_boxes *b, const lrt_refine *r, const double
 }
 
 /* TEST-ONLY: a volume holding just the boxes as elements and their union
- * box as the domain (no basis, not finished). */
+ * box as the domain, and min/max sides (no basis, not finished). */
 static inline sl_status lrt_boxes_volume(sl_lr_volume *lr, const lrt_boxes *b, sl_err *err)
 {
     sl_status st = sl_lr_alloc(lr, 0, 0, b->n, 0, err);
     if (st != SL_OK)
         return st;
     for (int d = 0; d < 3; d++) {
-        lr->domain_lo[d] = INFINITY;
-        lr->domain_hi[d] = -INFINITY;
+        lr->domain_lo[d] = lr->min_side[d] = INFINITY;
+        lr->domain_hi[d] = lr->max_side[d] = -INFINITY;
     }
     for (size_t i = 0; i < b->n; i++)
         for (int d = 0; d < 3; d++) {
@@ -165,6 +165,8 @@ static inline sl_status lrt_boxes_volume(sl_lr_volume *lr, const lrt_boxes *b, s
             lr->elements[i].hi[d] = b->hi[i][d];
             lr->domain_lo[d] = fmin(lr->domain_lo[d], b->lo[i][d]);
             lr->domain_hi[d] = fmax(lr->domain_hi[d], b->hi[i][d]);
+            lr->min_side[d] = fmin(lr->min_side[d], b->hi[i][d] - b->lo[i][d]);
+            lr->max_side[d] = fmax(lr->max_side[d], b->hi[i][d] - b->lo[i][d]);
         }
     return SL_OK;
 }
