@@ -120,7 +120,7 @@ sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_loo
         st = sl_lr_lookup_build_texture(lk, lr, err);
         break;
     case SL_LR_LOOKUP_OCTREE:
-        st = sl_lr_lookup_build_octree(lk, lr, err);
+        st = sl_lr_lookup_build_octree(lk, lr, SL_LR_OCTREE_MAX_CELLS, err);
         break;
     case SL_LR_LOOKUP_KDTREE:
         st = sl_lr_lookup_build_forest(lk, lr, 1, err);
@@ -130,20 +130,21 @@ sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_loo
         st = sl_lr_lookup_build_forest(lk, lr, forest_axis ? forest_axis : SL_LR_FOREST_DEFAULT_AXIS, err);
         break;
     case SL_LR_LOOKUP_AUTO: {
-        /* The rule (bench/RESULTS.md, bench-lr-lookup): the texture is the
-         * fastest wherever it applies; otherwise the default k-d forest. */
+        /* The rule of sl_lr_lookup.h (measured by bench-lr-lookup): texture,
+         * else a compact octree, else the default k-d forest. */
         sl_err quiet;
         st = sl_lr_lookup_build_texture(lk, lr, &quiet);
-        if (st == SL_ERR_UNSUPPORTED) {
+        for (int step = 0; step < 2 && (st == SL_ERR_UNSUPPORTED || st == SL_ERR_LIMIT); step++) {
             sl_lr_lookup_free(lk);
             for (int d = 0; d < 3; d++) {
                 lk->lo[d] = lr->domain_lo[d];
                 lk->hi[d] = lr->domain_hi[d];
             }
-            st = sl_lr_lookup_build_forest(lk, lr, SL_LR_FOREST_DEFAULT_AXIS, err);
-        } else if (st != SL_OK) {
-            *err = quiet;
+            st = step == 0 ? sl_lr_lookup_build_octree(lk, lr, lr->element_count, &quiet)
+                           : sl_lr_lookup_build_forest(lk, lr, SL_LR_FOREST_DEFAULT_AXIS, &quiet);
         }
+        if (st != SL_OK)
+            *err = quiet;
         break;
     }
     default:

@@ -15,7 +15,8 @@ double *sl_lr_lookup_distinct_faces(const sl_lr_volume *lr, int d, size_t *n);
 int sl_lr_lookup_cell(const double *planes, int n, double lo, double hi, double p);
 
 sl_status sl_lr_lookup_build_texture(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_err *err);
-sl_status sl_lr_lookup_build_octree(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_err *err);
+/* At most max_cells split cells, else SL_ERR_LIMIT. */
+sl_status sl_lr_lookup_build_octree(sl_lr_lookup *lk, const sl_lr_volume *lr, size_t max_cells, sl_err *err);
 /* kdtree = forest of 1 x 1 x 1 blocks. */
 sl_status sl_lr_lookup_build_forest(sl_lr_lookup *lk, const sl_lr_volume *lr, int axis_blocks, sl_err *err);
 

@@ -5,7 +5,9 @@
  * queries are exact). Knots become integers K on the finest grid of
  * 2^SL_LR_OCTREE_MAX_LEVEL cells per direction; the tree is built on those
  * integers: a cell met by more than one element is split into 8 at its
- * middle (the middle plane is the knot there, else the dyadic value).
+ * middle (the middle plane is the knot there, else the dyadic value). A
+ * fine knot plane across big elements splits every cell along it, so the
+ * split cells are capped (SL_ERR_LIMIT past the cap).
  * Any thread; no GL.
  */
 #include "lr_lookup_internal.h"
@@ -24,7 +26,7 @@ typedef struct oct_builder {
     size_t count[3];
     double lo[3], side[3];
     sl_lr_octnode *nodes;
-    size_t n, cap;
+    size_t n, cap, max_cells;
     int max_depth, failed;
 } oct_builder;
 
@@ -63,6 +65,10 @@ static uint32_t oct_build(oct_builder *b, const uint32_t c0[3], uint32_t size, c
         return SL_LR_REF_LEAF | (count ? elems[0] : SL_LR_REF_NONE);
     if (size < 2 || b->failed) {
         b->failed = b->failed ? b->failed : 2;
+        return SL_LR_REF_LEAF | SL_LR_REF_NONE;
+    }
+    if (b->n >= b->max_cells) {
+        b->failed = 3;
         return SL_LR_REF_LEAF | SL_LR_REF_NONE;
     }
     if (b->n == b->cap) {
@@ -107,11 +113,11 @@ static uint32_t oct_build(oct_builder *b, const uint32_t c0[3], uint32_t size, c
     return (uint32_t)at;
 }
 
-sl_status sl_lr_lookup_build_octree(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_err *err)
+sl_status sl_lr_lookup_build_octree(sl_lr_lookup *lk, const sl_lr_volume *lr, size_t max_cells, sl_err *err)
 {
     static const char axis[3] = {'x', 'y', 'z'};
     lk->kind = SL_LR_LOOKUP_OCTREE;
-    oct_builder b = {.lr = lr};
+    oct_builder b = {.lr = lr, .max_cells = max_cells};
     sl_status st = SL_OK;
     uint32_t *all = NULL;
     b.klo = malloc(lr->element_count * sizeof *b.klo);
@@ -170,8 +176,11 @@ sl_status sl_lr_lookup_build_octree(sl_lr_lookup *lk, const sl_lr_volume *lr, sl
     lk->oct_count = b.n;
     b.nodes = NULL;
     if (b.failed) {
-        st = b.failed == 1 ? sl_err_set(err, SL_ERR_NOMEM, "octree: out of memory for the cells")
-                           : sl_err_set(err, SL_ERR_INVALID, "octree: elements overlap at the finest level");
+        st = b.failed == 1   ? sl_err_set(err, SL_ERR_NOMEM, "octree: out of memory for the cells")
+             : b.failed == 3 ? sl_err_set(err, SL_ERR_LIMIT, "octree: more than %zu split cells would be needed "
+                                          "(element faces on fine dyadic planes across large elements); use kdforest",
+                                          max_cells)
+                             : sl_err_set(err, SL_ERR_INVALID, "octree: elements overlap at the finest level");
         goto done;
     }
     int depth = b.max_depth;

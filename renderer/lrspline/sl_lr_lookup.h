@@ -17,7 +17,8 @@
  *             SL_LR_OCTREE_MAX_LEVEL, relative tolerance 1e-12 of side, the
  *             knot itself becomes the split plane); a cell is split in 8
  *             while more than one element meets it. Refused naming the first
- *             non-dyadic knot (element, direction, value).
+ *             non-dyadic knot (element, direction, value); SL_ERR_LIMIT past
+ *             SL_LR_OCTREE_MAX_CELLS split cells.
  *  kdtree   — one depth-balanced k-d tree: at a node with more than one
  *             element, for each direction the median of the element faces
  *             strictly inside the node's cell is a candidate plane; the one
@@ -27,8 +28,13 @@
  *  kdforest — the domain cut into I x J x K regular blocks, one such k-d
  *             tree per block over the elements meeting the block; a block
  *             met by one element stores it directly (depth 0).
- *  auto     — texture when it applies, else the k-d forest at the default
- *             block count (rule from bench/bench_lr_lookup.c, RESULTS.md).
+ *  auto     — the texture when it applies; else the octree when it applies
+ *             with at most as many split cells as there are elements; else
+ *             the k-d forest of SL_LR_FOREST_DEFAULT_AXIS^3 blocks. Measured
+ *             by bench-lr-lookup (bench/RESULTS.md): texture fastest where it
+ *             applies; on a dyadic refined mesh the compact octree beat the
+ *             forest on the CPU and mostly on llvmpipe; 32^3 blocks was the
+ *             best or near-best forest on all three test meshes.
  *
  * Any thread for building and CPU queries (read-only once built); the GPU
  * functions need the render thread's GL context.
@@ -44,6 +50,7 @@
 #define SL_LR_TEXTURE_MAX_AXIS 1024u
 #define SL_LR_TEXTURE_MAX_CELLS (16u * 1024u * 1024u)   /* 64 MiB of uint32 */
 #define SL_LR_OCTREE_MAX_LEVEL 30
+#define SL_LR_OCTREE_MAX_CELLS (1024u * 1024u)            /* split cells, 44 B each on the GPU */
 #define SL_LR_FOREST_MAX_BLOCKS (2u * 1024u * 1024u)   /* 128^3 */
 #define SL_LR_FOREST_DEFAULT_AXIS 32                   /* see RESULTS.md */
 

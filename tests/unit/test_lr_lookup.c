@@ -102,6 +102,22 @@ static sl_status check_kind(const char *name, const sl_lr_volume *lr, const prob
 
 static void check_all(const char *name, const sl_lr_volume *lr, int expect_texture, int expect_octree)
 {
+    {
+        /* auto: texture, else a compact octree, else the k-d forest. */
+        sl_err e0;
+        sl_lr_lookup a, o;
+        int compact = expect_octree && sl_lr_lookup_build(&o, lr, SL_LR_LOOKUP_OCTREE, 0, &e0) == SL_OK &&
+                      o.oct_count <= lr->element_count;
+        if (expect_octree && o.kind == SL_LR_LOOKUP_OCTREE)
+            sl_lr_lookup_free(&o);
+        sl_lr_lookup_kind want = expect_texture ? SL_LR_LOOKUP_TEXTURE
+                               : compact        ? SL_LR_LOOKUP_OCTREE
+                                                : SL_LR_LOOKUP_KDFOREST;
+        SL_CHECK(sl_lr_lookup_build(&a, lr, SL_LR_LOOKUP_AUTO, 0, &e0) == SL_OK);
+        SL_CHECK_MSG(a.kind == want, "%s: auto chose %s, expected %s", name, sl_lr_lookup_kind_name(a.kind),
+                     sl_lr_lookup_kind_name(want));
+        sl_lr_lookup_free(&a);
+    }
     probe_set ps;
     if (!probes_make(&ps, lr, PROBES, 0x9E3779B97F4A7C15ull ^ lr->element_count)) {
         SL_CHECK(!"out of memory");
@@ -168,6 +184,15 @@ static void test_tensor(void)
     SL_CHECK_MSG(st == SL_ERR_UNSUPPORTED && strstr(err.message, "512 x 512 x 512") && strstr(err.message, "limit"),
                  "%s", st ? err.message : "built");
     check_all("fine-grid", &lr, 0, 1);
+    sl_lr_free(&lr);
+    /* An octree past its cell cap: a knot at 2^-12 across the domain. */
+    double f0[] = {0, 1.0 / 4096, 1};
+    const double *bf[3] = {f0, f0, f0};
+    SL_CHECK(lrt_tensor(&lr, 2, bf, mt, &err) == SL_OK);
+    st = sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_OCTREE, 0, &err);
+    SL_CHECK_MSG(st == SL_ERR_LIMIT && strstr(err.message, "split cells"), "%s", st ? err.message : "built");
+    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_AUTO, 0, &err) == SL_OK && lk.kind == SL_LR_LOOKUP_KDFOREST);
+    sl_lr_lookup_free(&lk);
     sl_lr_free(&lr);
 }
 
