@@ -14,7 +14,8 @@
  * (a 3^3 grid split at 0.4 of each side near the point to level 10 and the
  * sphere to level 4: only the k-d structures apply, no block alignment).
  * The GPU answers are compared with the CPU ones (column "GPU=CPU").
- * Also the kind by #define against by uniform (GPU, k-d forest default).
+ * Also the GPU variants: kind by #define or by uniform, heads from the SSBO
+ * or from a GL_R32UI 3D texture (texture and default forest).
  * Usage: bench-lr-lookup [--points N] [--repeat R] [--forests 1,8,32,64,128]
  * Main thread = render thread. Prints Markdown; checks nothing else.
  */
@@ -67,14 +68,16 @@ static void points_free(points *ps)
     free(ps->d);
 }
 
-static GLuint programs[5];
+static GLuint programs[10]; /* [0]: kind by uniform; [k]: LR_LOOKUP_KIND k; [5 + k]: and heads texture */
 
 static GLuint program_for(int slot)
 {
     if (!programs[slot]) {
         sl_err err;
-        sl_program_desc desc = {.compute = "lrspline/lr_lookup_probe.comp.glsl",
-                                .defines = slot ? sl_lr_lookup_glsl_define((sl_lr_lookup_kind)slot) : NULL,
+        char defines[128];
+        snprintf(defines, sizeof defines, "%s%s", slot ? sl_lr_lookup_glsl_define((sl_lr_lookup_kind)(slot % 5)) : "",
+                 slot >= 5 ? "#define LR_LOOKUP_HEADS_TEXTURE\n" : "");
+        sl_program_desc desc = {.compute = "lrspline/lr_lookup_probe.comp.glsl", .defines = defines,
                                 .label = "lr_lookup_probe"};
         if (sl_gl_program_create(&desc, &programs[slot], &err) != SL_OK) {
             fprintf(stderr, "bench-lr-lookup: %s\n", err.message);
@@ -201,23 +204,33 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
         sl_lr_lookup_free(&lk);
     }
     printf("\n");
-    /* #define against uniform, the default forest. */
-    sl_err err;
-    sl_lr_lookup lk;
-    if (sl_lr_lookup_build(&lk, lr, SL_LR_LOOKUP_KDFOREST, 0, &err) == SL_OK) {
+    /* GPU variants (weighted points): kind by uniform or #define, heads
+     * from the SSBO or the 3D texture. */
+    printf("GPU variants, weighted points, ns per point (best of %d):\n\n", o->repeat);
+    printf("| structure | kind by uniform, heads SSBO | `#define LR_LOOKUP_KIND`, heads SSBO | `#define`, heads 3D texture |\n");
+    printf("|---|---:|---:|---:|\n");
+    sl_lr_lookup_kind vk[2] = {SL_LR_LOOKUP_TEXTURE, SL_LR_LOOKUP_KDFOREST};
+    for (int v = 0; v < 2; v++) {
+        sl_err err;
+        sl_lr_lookup lk;
+        if (sl_lr_lookup_build(&lk, lr, vk[v], 0, &err) != SL_OK)
+            continue;
         sl_lr_lookup_gpu g;
         if (sl_lr_lookup_gpu_upload(&g, &lk, &err) == SL_OK) {
             cpu_time(&lk, &ps[1], cpu, 1);
-            size_t m0 = 0, m1 = 0;
-            double def = gpu_time(&g, (int)lk.kind, &ps[1], cpu, o->repeat, &m0);
-            double uni = gpu_time(&g, 0, &ps[1], cpu, o->repeat, &m1);
-            printf("GPU kind selection, kdforest %d^3, weighted points: `#define LR_LOOKUP_KIND` %.1f ns, "
-                   "uniform `lr_lookup_kind` %.1f ns per point%s.\n\n", SL_LR_FOREST_DEFAULT_AXIS, def, uni,
-                   m0 + m1 ? " (MISMATCHES)" : "");
+            size_t m[3] = {0, 0, 0};
+            double t0 = gpu_time(&g, 0, &ps[1], cpu, o->repeat, &m[0]);
+            double t1 = gpu_time(&g, (int)lk.kind, &ps[1], cpu, o->repeat, &m[1]);
+            double t2 = g.heads_texture ? gpu_time(&g, 5 + (int)lk.kind, &ps[1], cpu, o->repeat, &m[2]) : NAN;
+            char label[32];
+            snprintf(label, sizeof label, vk[v] == SL_LR_LOOKUP_KDFOREST ? "kdforest %d^3" : "texture",
+                     SL_LR_FOREST_DEFAULT_AXIS);
+            printf("| %s | %.1f | %.1f | %.1f |%s\n", label, t0, t1, t2, m[0] + m[1] + m[2] ? " MISMATCHES" : "");
             sl_lr_lookup_gpu_free(&g);
         }
         sl_lr_lookup_free(&lk);
     }
+    printf("\n");
     points_free(&ps[0]);
     points_free(&ps[1]);
     free(cpu);
@@ -298,7 +311,7 @@ int main(int argc, char **argv)
     }
     bench_volume("refined-nondyadic", &lr, &o);
     sl_lr_free(&lr);
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 10; i++)
         if (programs[i])
             glDeleteProgram(programs[i]);
     sl_gpu_destroy(gpu);

@@ -6,6 +6,9 @@
 // float just at or above their double value, so float points get exactly the
 // CPU (double) answer. Kind: LR_LOOKUP_KIND (1 texture, 2 octree, 3 kdtree,
 // 4 kdforest) when #defined at program build, else the uniform lr_lookup_kind.
+// LR_LOOKUP_HEADS_TEXTURE #defined: the heads are read from the GL_R32UI 3D
+// texture on unit 8 (lr_lookup_heads_tex) instead of binding 8, as in the
+// paper (measured against the SSBO in bench-lr-lookup).
 // Includable (no #version); reads only its own buffers and uniforms.
 
 layout(std430, binding = 8) readonly buffer LrLookupHeads { uint lr_heads[]; };
@@ -19,6 +22,9 @@ uniform vec3 lr_lookup_origin;
 uniform vec3 lr_lookup_scale;
 #ifndef LR_LOOKUP_KIND
 uniform int lr_lookup_kind;
+#endif
+#ifdef LR_LOOKUP_HEADS_TEXTURE
+uniform usampler3D lr_lookup_heads_tex;
 #endif
 
 // Cell of coordinate x of direction `axis` among its planes (which start at
@@ -58,7 +64,11 @@ int lr_find_element(vec3 p)
     int cx = lr_lookup_cell(p.x, 0, 0);
     int cy = lr_lookup_cell(p.y, 1, lr_lookup_n.x + 1);
     int cz = lr_lookup_cell(p.z, 2, lr_lookup_n.x + lr_lookup_n.y + 2);
+#ifdef LR_LOOKUP_HEADS_TEXTURE
+    uint head = texelFetch(lr_lookup_heads_tex, ivec3(cx, cy, cz), 0).r;
+#else
     uint head = lr_heads[cx + lr_lookup_n.x * (cy + lr_lookup_n.y * cz)];
+#endif
     if (kind == 1) // texture
         return int(head);
     if ((head & 0x80000000u) != 0u) { // a block holding one element

@@ -1,7 +1,8 @@
 /* lr_lookup_gpu.c — the flattened GPU form of an sl_lr_lookup (layout in
- * sl_lr_lookup.h, read by lr_lookup.glsl): three SSBOs at bindings 8..10
- * and the uniforms of a program. Planes go to the float at or above their
- * double value and the domain inwards, which keeps float queries exact.
+ * sl_lr_lookup.h, read by lr_lookup.glsl): three SSBOs at bindings 8..10,
+ * the heads also as a 3D texture on unit 8, and the uniforms of a program.
+ * Planes go to the float at or above their double value and the domain
+ * inwards, which keeps float queries exact.
  * Render thread only (GL).
  */
 #include "sl_lr_lookup.h"
@@ -105,6 +106,19 @@ sl_status sl_lr_lookup_gpu_upload(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, s
     g->nodes = make_buffer(nodes, nn * sizeof *nodes);
     g->planes = make_buffer(planes, np * sizeof *planes);
     g->bytes = (nh + nn + np) * 4;
+    if (lk->kind != SL_LR_LOOKUP_OCTREE) {
+        GLint max3d = 0;
+        glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
+        if (g->n[0] <= max3d && g->n[1] <= max3d && g->n[2] <= max3d) {
+            glCreateTextures(GL_TEXTURE_3D, 1, &g->heads_texture);
+            glTextureStorage3D(g->heads_texture, 1, GL_R32UI, g->n[0], g->n[1], g->n[2]);
+            glTextureParameteri(g->heads_texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTextureParameteri(g->heads_texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+            glTextureSubImage3D(g->heads_texture, 0, 0, 0, 0, g->n[0], g->n[1], g->n[2], GL_RED_INTEGER,
+                                GL_UNSIGNED_INT, heads);
+        }
+    }
     free(heads);
     free(nodes);
     free(planes);
@@ -126,12 +140,16 @@ void sl_lr_lookup_gpu_bind(const sl_lr_lookup_gpu *g, unsigned int program)
     glUniform3fv(glGetUniformLocation(program, "lr_lookup_origin"), 1, g->origin);
     glUniform3fv(glGetUniformLocation(program, "lr_lookup_scale"), 1, g->scale);
     glUniform1i(glGetUniformLocation(program, "lr_lookup_kind"), (GLint)g->kind); /* -1 location when #defined */
+    glBindTextureUnit(SL_LR_LOOKUP_UNIT_HEADS, g->heads_texture);
+    glUniform1i(glGetUniformLocation(program, "lr_lookup_heads_tex"), SL_LR_LOOKUP_UNIT_HEADS);
 }
 
 void sl_lr_lookup_gpu_free(sl_lr_lookup_gpu *g)
 {
     GLuint b[3] = {g->heads, g->nodes, g->planes};
     glDeleteBuffers(3, b);
+    if (g->heads_texture)
+        glDeleteTextures(1, &g->heads_texture);
     memset(g, 0, sizeof *g);
 }
 

@@ -7,7 +7,8 @@
  * (uniform, on/beside element faces, edges, corners and the domain's, just
  * outside; each coordinate also moved one float ulp down or up) for every
  * applicable structure, forest sizes 1, 8, 32, the kind compiled in by
- * #define and chosen by the uniform. Every answer must equal the reference
+ * #define and chosen by the uniform, and with the heads read from the 3D
+ * texture (LR_LOOKUP_HEADS_TEXTURE). Every answer must equal the reference
  * exactly (the planes' round-up makes float queries exact). Render thread =
  * main thread.
  */
@@ -23,14 +24,16 @@
 
 #define PROBES 200000
 
-static GLuint programs[5]; /* [0]: kind by uniform; [k]: LR_LOOKUP_KIND k */
+static GLuint programs[10]; /* [0]: kind by uniform; [k]: LR_LOOKUP_KIND k; [5 + k]: and heads texture */
 
 static int program_for(int slot, sl_err *err)
 {
     if (programs[slot])
         return 1;
-    sl_program_desc desc = {.compute = "lrspline/lr_lookup_probe.comp.glsl",
-                            .defines = slot ? sl_lr_lookup_glsl_define((sl_lr_lookup_kind)slot) : NULL,
+    char defines[128];
+    snprintf(defines, sizeof defines, "%s%s", slot ? sl_lr_lookup_glsl_define((sl_lr_lookup_kind)(slot % 5)) : "",
+             slot >= 5 ? "#define LR_LOOKUP_HEADS_TEXTURE\n" : "");
+    sl_program_desc desc = {.compute = "lrspline/lr_lookup_probe.comp.glsl", .defines = defines,
                             .label = "lr_lookup_probe"};
     return sl_gl_program_create(&desc, &programs[slot], err) == SL_OK;
 }
@@ -83,8 +86,10 @@ static void check_volume(const char *name, const sl_lr_volume *lr, int texture, 
         sl_lr_lookup_gpu g;
         st = sl_lr_lookup_gpu_upload(&g, &lk, &err);
         SL_CHECK_MSG(st == SL_OK, "%s", err.message);
-        for (int slot = 0; slot < 2 && st == SL_OK; slot++) {
-            int ps = slot ? (int)lk.kind : 0;
+        for (int slot = 0; slot < 3 && st == SL_OK; slot++) {
+            if (slot == 2 && lk.kind == SL_LR_LOOKUP_OCTREE)
+                break;
+            int ps = slot == 0 ? 0 : slot == 1 ? (int)lk.kind : 5 + (int)lk.kind;
             if (!program_for(ps, &err)) {
                 SL_CHECK_MSG(0, "%s", err.message);
                 break;
@@ -100,11 +105,11 @@ static void check_volume(const char *name, const sl_lr_volume *lr, int texture, 
             }
             SL_CHECK_MSG(bad == 0, "%s %s/%d (%s): %zu of %d GPU answers differ; first (%.9g %.9g %.9g) gives %d, "
                          "reference %ld", name, sl_lr_lookup_kind_name(lk.kind), cases[c].forest,
-                         slot ? "#define" : "uniform", bad, PROBES, pts[3 * first], pts[3 * first + 1],
+                         slot == 2 ? "heads3d" : slot ? "#define" : "uniform", bad, PROBES, pts[3 * first], pts[3 * first + 1],
                          pts[3 * first + 2], got[first], ref[first]);
             SL_CHECK(cpu_bad == 0);
             printf("  %-10s %-8s n=%-3d %-8s GPU %zu bytes: %zu/%d differ\n", name, sl_lr_lookup_kind_name(lk.kind),
-                   cases[c].forest, slot ? "#define" : "uniform", g.bytes, bad, PROBES);
+                   cases[c].forest, slot == 2 ? "heads3d" : slot ? "#define" : "uniform", g.bytes, bad, PROBES);
         }
         SL_CHECK(sl_gl_check_errors("lr look-up probe", &err) == SL_OK);
         sl_lr_lookup_gpu_free(&g);
@@ -149,7 +154,7 @@ int main(void)
     SL_CHECK(lrt_refined(&lr, lo, hi, 3, &rf, &err) == SL_OK);
     check_volume("nondyadic", &lr, 0, 0);
     sl_lr_free(&lr);
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 10; i++)
         if (programs[i])
             glDeleteProgram(programs[i]);
     sl_gpu_destroy(gpu);
