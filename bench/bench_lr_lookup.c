@@ -175,14 +175,14 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
             snprintf(label, sizeof label, "kdforest %d^3", runs[k].forest);
         else
             snprintf(label, sizeof label, "%s", sl_lr_lookup_kind_name(runs[k].kind));
-        if (sl_lr_lookup_build(&lk, lr, runs[k].kind, runs[k].forest, &err) != SL_OK) {
+        if (sl_lr_lookup_init(&lk, lr, runs[k].kind, runs[k].forest, &err) != SL_OK) {
             printf("| %s | refused: %s |||||||||||||||\n", label, err.message);
             continue;
         }
         sl_lr_lookup_gpu g;
-        if (sl_lr_lookup_gpu_upload(&g, &lk, &err) != SL_OK) {
+        if (sl_lr_lookup_gpu_init(&g, &lk, &err) != SL_OK) {
             printf("| %s | GPU upload failed: %s |||||||||||||||\n", label, err.message);
-            sl_lr_lookup_free(&lk);
+            sl_lr_lookup_deinit(&lk);
             continue;
         }
         double cns[2], gns[2];
@@ -200,8 +200,8 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
                gns[0], gns[1], mism ? "NO" : "yes");
         if (mism)
             fprintf(stderr, "bench-lr-lookup: %s %s: %zu GPU answers differ from the CPU\n", name, label, mism);
-        sl_lr_lookup_gpu_free(&g);
-        sl_lr_lookup_free(&lk);
+        sl_lr_lookup_gpu_deinit(&g);
+        sl_lr_lookup_deinit(&lk);
     }
     printf("\n");
     /* GPU variants (weighted points): kind by uniform or #define, heads
@@ -213,10 +213,10 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
     for (int v = 0; v < 2; v++) {
         sl_err err;
         sl_lr_lookup lk;
-        if (sl_lr_lookup_build(&lk, lr, vk[v], 0, &err) != SL_OK)
+        if (sl_lr_lookup_init(&lk, lr, vk[v], 0, &err) != SL_OK)
             continue;
         sl_lr_lookup_gpu g;
-        if (sl_lr_lookup_gpu_upload(&g, &lk, &err) == SL_OK) {
+        if (sl_lr_lookup_gpu_init(&g, &lk, &err) == SL_OK) {
             cpu_time(&lk, &ps[1], cpu, 1);
             size_t m[3] = {0, 0, 0};
             double t0 = gpu_time(&g, 0, &ps[1], cpu, o->repeat, &m[0]);
@@ -226,9 +226,9 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
             snprintf(label, sizeof label, vk[v] == SL_LR_LOOKUP_KDFOREST ? "kdforest %d^3" : "texture",
                      SL_LR_FOREST_DEFAULT_AXIS);
             printf("| %s | %.1f | %.1f | %.1f |%s\n", label, t0, t1, t2, m[0] + m[1] + m[2] ? " MISMATCHES" : "");
-            sl_lr_lookup_gpu_free(&g);
+            sl_lr_lookup_gpu_deinit(&g);
         }
-        sl_lr_lookup_free(&lk);
+        sl_lr_lookup_deinit(&lk);
     }
     printf("\n");
     points_free(&ps[0]);

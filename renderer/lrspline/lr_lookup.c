@@ -86,7 +86,7 @@ void sl_lr_lookup_depth_stats(sl_lr_lookup_stats *s, const int *depth, size_t tr
     s->depth_var = trees ? sum2 / (double)trees : 0.0;
 }
 
-void sl_lr_lookup_free(sl_lr_lookup *lk)
+void sl_lr_lookup_deinit(sl_lr_lookup *lk)
 {
     for (int d = 0; d < 3; d++)
         free(lk->planes[d]);
@@ -96,8 +96,8 @@ void sl_lr_lookup_free(sl_lr_lookup *lk)
     memset(lk, 0, sizeof *lk);
 }
 
-sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_lookup_kind kind,
-                             int forest_axis, sl_err *err)
+sl_status sl_lr_lookup_init(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_lookup_kind kind,
+                            int forest_axis, sl_err *err)
 {
     memset(lk, 0, sizeof *lk);
     if (!lr || lr->element_count == 0)
@@ -135,7 +135,7 @@ sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_loo
         sl_err quiet;
         st = sl_lr_lookup_build_texture(lk, lr, &quiet);
         for (int step = 0; step < 2 && (st == SL_ERR_UNSUPPORTED || st == SL_ERR_LIMIT); step++) {
-            sl_lr_lookup_free(lk);
+            sl_lr_lookup_deinit(lk);
             for (int d = 0; d < 3; d++) {
                 lk->lo[d] = lr->domain_lo[d];
                 lk->hi[d] = lr->domain_hi[d];
@@ -151,7 +151,7 @@ sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_loo
         return sl_err_set(err, SL_ERR_INVALID, "element look-up: unknown kind %d", (int)kind);
     }
     if (st != SL_OK) {
-        sl_lr_lookup_free(lk);
+        sl_lr_lookup_deinit(lk);
         return st;
     }
     timespec_get(&t1, TIME_UTC);

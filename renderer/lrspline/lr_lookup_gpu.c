@@ -45,7 +45,7 @@ static GLuint make_buffer(const void *data, size_t bytes)
     return b;
 }
 
-sl_status sl_lr_lookup_gpu_upload(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err)
+sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err)
 {
     memset(g, 0, sizeof *g);
     g->kind = lk->kind;
@@ -124,7 +124,7 @@ sl_status sl_lr_lookup_gpu_upload(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, s
     free(planes);
     sl_status st = sl_gl_check_errors("uploading the element look-up", err);
     if (st != SL_OK)
-        sl_lr_lookup_gpu_free(g);
+        sl_lr_lookup_gpu_deinit(g);
     return st;
 }
 
@@ -144,7 +144,7 @@ void sl_lr_lookup_gpu_bind(const sl_lr_lookup_gpu *g, unsigned int program)
     glUniform1i(glGetUniformLocation(program, "lr_lookup_heads_tex"), SL_LR_LOOKUP_UNIT_HEADS);
 }
 
-void sl_lr_lookup_gpu_free(sl_lr_lookup_gpu *g)
+void sl_lr_lookup_gpu_deinit(sl_lr_lookup_gpu *g)
 {
     GLuint b[3] = {g->heads, g->nodes, g->planes};
     glDeleteBuffers(3, b);

@@ -115,13 +115,16 @@ typedef struct sl_lr_lookup {
     sl_lr_lookup_stats stats;
 } sl_lr_lookup;
 
-/* Builds `kind`; forest_axis = blocks per direction for kdforest (0: the
- * default; 1..128, at most SL_LR_FOREST_MAX_BLOCKS in all; ignored by the
- * others). Refusals as above (SL_ERR_UNSUPPORTED), SL_ERR_LIMIT/NOMEM for
- * memory. The volume must be finished (domain filled). */
-sl_status sl_lr_lookup_build(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_lookup_kind kind,
-                             int forest_axis, sl_err *err);
-void sl_lr_lookup_free(sl_lr_lookup *lk);
+/* Builds `kind` into the caller's *lk (owns its arrays; the volume is only
+ * read); forest_axis = blocks per direction for kdforest (0: the default;
+ * 1..128; ignored by the others). Refusals as above (SL_ERR_UNSUPPORTED,
+ * the octree's cell cap SL_ERR_LIMIT), SL_ERR_INVALID for an empty domain
+ * or overlapping elements, SL_ERR_NOMEM; on failure *lk is zeroed, owning
+ * nothing. The volume needs elements and domain_lo/hi (sl_lr_finish). */
+sl_status sl_lr_lookup_init(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_lookup_kind kind,
+                            int forest_axis, sl_err *err);
+/* Frees the arrays; safe on a zeroed or failed *lk. */
+void sl_lr_lookup_deinit(sl_lr_lookup *lk);
 
 /* The element containing p (element rule), -1 outside or for NaN. */
 long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
@@ -168,12 +171,14 @@ typedef struct sl_lr_lookup_gpu {
     size_t bytes;
 } sl_lr_lookup_gpu;
 
-/* Uploads a built structure (render thread). SL_ERR_GPU on a GL error. */
-sl_status sl_lr_lookup_gpu_upload(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err);
+/* Uploads a built structure into GL objects owned by *g (render thread);
+ * SL_ERR_GPU on a GL error, SL_ERR_NOMEM; on failure *g owns nothing.
+ * deinit is safe on a zeroed *g. */
+sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err);
 /* Binds the buffers to 8..10 and the heads texture to unit 8 and sets the
  * uniforms of `program` (which is made current). */
 void sl_lr_lookup_gpu_bind(const sl_lr_lookup_gpu *g, unsigned int program);
-void sl_lr_lookup_gpu_free(sl_lr_lookup_gpu *g);
+void sl_lr_lookup_gpu_deinit(sl_lr_lookup_gpu *g);
 /* "#define LR_LOOKUP_KIND k\n" for sl_program_desc.defines: the look-up of
  * that kind alone is compiled (else lr_lookup_kind picks at run time). */
 const char *sl_lr_lookup_glsl_define(sl_lr_lookup_kind kind);

@@ -69,7 +69,7 @@ static sl_status check_kind(const char *name, const sl_lr_volume *lr, const prob
                             int forest, sl_err *err)
 {
     sl_lr_lookup lk;
-    sl_status st = sl_lr_lookup_build(&lk, lr, kind, forest, err);
+    sl_status st = sl_lr_lookup_init(&lk, lr, kind, forest, err);
     if (st != SL_OK)
         return st;
     size_t bad = 0, outside = 0, first = 0;
@@ -96,7 +96,7 @@ static sl_status check_kind(const char *name, const sl_lr_volume *lr, const prob
         SL_CHECK_MSG(s->depth_max <= 2.0 * lg + 4.0, "kdtree depth %d for %zu elements", s->depth_max,
                      lr->element_count);
     }
-    sl_lr_lookup_free(&lk);
+    sl_lr_lookup_deinit(&lk);
     return SL_OK;
 }
 
@@ -106,17 +106,17 @@ static void check_all(const char *name, const sl_lr_volume *lr, int expect_textu
         /* auto: texture, else a compact octree, else the k-d forest. */
         sl_err e0;
         sl_lr_lookup a, o;
-        int compact = expect_octree && sl_lr_lookup_build(&o, lr, SL_LR_LOOKUP_OCTREE, 0, &e0) == SL_OK &&
+        int compact = expect_octree && sl_lr_lookup_init(&o, lr, SL_LR_LOOKUP_OCTREE, 0, &e0) == SL_OK &&
                       o.oct_count <= lr->element_count;
         if (expect_octree && o.kind == SL_LR_LOOKUP_OCTREE)
-            sl_lr_lookup_free(&o);
+            sl_lr_lookup_deinit(&o);
         sl_lr_lookup_kind want = expect_texture ? SL_LR_LOOKUP_TEXTURE
                                : compact        ? SL_LR_LOOKUP_OCTREE
                                                 : SL_LR_LOOKUP_KDFOREST;
-        SL_CHECK(sl_lr_lookup_build(&a, lr, SL_LR_LOOKUP_AUTO, 0, &e0) == SL_OK);
+        SL_CHECK(sl_lr_lookup_init(&a, lr, SL_LR_LOOKUP_AUTO, 0, &e0) == SL_OK);
         SL_CHECK_MSG(a.kind == want, "%s: auto chose %s, expected %s", name, sl_lr_lookup_kind_name(a.kind),
                      sl_lr_lookup_kind_name(want));
-        sl_lr_lookup_free(&a);
+        sl_lr_lookup_deinit(&a);
     }
     probe_set ps;
     if (!probes_make(&ps, lr, PROBES, 0x9E3779B97F4A7C15ull ^ lr->element_count)) {
@@ -180,7 +180,7 @@ static void test_tensor(void)
     int mt[3] = {3, 3, 3};
     SL_CHECK(lrt_tensor(&lr, 2, bt, mt, &err) == SL_OK);
     sl_lr_lookup lk;
-    sl_status st = sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &err);
+    sl_status st = sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &err);
     SL_CHECK_MSG(st == SL_ERR_UNSUPPORTED && strstr(err.message, "512 x 512 x 512") && strstr(err.message, "limit"),
                  "%s", st ? err.message : "built");
     check_all("fine-grid", &lr, 0, 1);
@@ -189,10 +189,10 @@ static void test_tensor(void)
     double f0[] = {0, 1.0 / 4096, 1};
     const double *bf[3] = {f0, f0, f0};
     SL_CHECK(lrt_tensor(&lr, 2, bf, mt, &err) == SL_OK);
-    st = sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_OCTREE, 0, &err);
+    st = sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_OCTREE, 0, &err);
     SL_CHECK_MSG(st == SL_ERR_LIMIT && strstr(err.message, "split cells"), "%s", st ? err.message : "built");
-    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_AUTO, 0, &err) == SL_OK && lk.kind == SL_LR_LOOKUP_KDFOREST);
-    sl_lr_lookup_free(&lk);
+    SL_CHECK(sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_AUTO, 0, &err) == SL_OK && lk.kind == SL_LR_LOOKUP_KDFOREST);
+    sl_lr_lookup_deinit(&lk);
     sl_lr_free(&lr);
 }
 
@@ -209,7 +209,7 @@ static void test_refined(void)
     check_all("refined", &lr, 0, 1);
     sl_err e2;
     sl_lr_lookup lk;
-    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &e2) == SL_ERR_UNSUPPORTED &&
+    SL_CHECK(sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &e2) == SL_ERR_UNSUPPORTED &&
              strstr(e2.message, "no regular grid of at most 1024"));
     sl_lr_free(&lr);
     /* The same at the point only on a domain [0,1]^3 split at the middle:
@@ -217,7 +217,7 @@ static void test_refined(void)
     double ulo[3] = {0, 0, 0}, uhi[3] = {1, 1, 1};
     lrt_refine rp = {.point = {0.3, 0.7, 0.5}, .point_level = 10, .t = 0.5};
     SL_CHECK(lrt_refined(&lr, ulo, uhi, 1, &rp, &err) == SL_OK);
-    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &e2) == SL_ERR_UNSUPPORTED &&
+    SL_CHECK(sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_TEXTURE, 0, &e2) == SL_ERR_UNSUPPORTED &&
              strstr(e2.message, "1024 x 1024 x 1024"));
     check_all("point", &lr, 0, 1);
     sl_lr_free(&lr);
@@ -229,7 +229,7 @@ static void test_refined(void)
     printf("refined non-dyadic: %zu elements\n", lr.element_count);
     check_all("nondyadic", &lr, 0, 0);
     {
-        sl_status st = sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_OCTREE, 0, &e2);
+        sl_status st = sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_OCTREE, 0, &e2);
         SL_CHECK_MSG(st == SL_ERR_UNSUPPORTED && strstr(e2.message, "knot ") && strstr(e2.message, "(element "),
                      "%s", e2.message);
     }
@@ -251,11 +251,11 @@ static void test_kinds(void)
     sl_lr_volume lr;
     SL_CHECK(lrt_tensor(&lr, 1, bb, mb, &err) == SL_OK);
     sl_lr_lookup lk;
-    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_KDFOREST, 129, &err) == SL_ERR_INVALID);
-    SL_CHECK(sl_lr_lookup_build(&lk, &lr, SL_LR_LOOKUP_KDTREE, 0, &err) == SL_OK);
+    SL_CHECK(sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_KDFOREST, 129, &err) == SL_ERR_INVALID);
+    SL_CHECK(sl_lr_lookup_init(&lk, &lr, SL_LR_LOOKUP_KDTREE, 0, &err) == SL_OK);
     double p[3] = {1, 1, 1}, q[3] = {1, 1, 1.0000001};
     SL_CHECK(sl_lr_lookup_find(&lk, p) == 0 && sl_lr_lookup_find(&lk, q) == -1);
-    sl_lr_lookup_free(&lk);
+    sl_lr_lookup_deinit(&lk);
     sl_lr_free(&lr);
 }
 

@@ -77,14 +77,14 @@ static void check_volume(const char *name, const sl_lr_volume *lr, int texture, 
     for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
         sl_err err;
         sl_lr_lookup lk;
-        sl_status st = sl_lr_lookup_build(&lk, lr, cases[c].kind, cases[c].forest, &err);
+        sl_status st = sl_lr_lookup_init(&lk, lr, cases[c].kind, cases[c].forest, &err);
         int expect = cases[c].kind == SL_LR_LOOKUP_TEXTURE ? texture : cases[c].kind == SL_LR_LOOKUP_OCTREE ? octree : 1;
         SL_CHECK_MSG((st == SL_OK) == expect, "%s %s: %s", name, sl_lr_lookup_kind_name(cases[c].kind),
                      st ? err.message : "built");
         if (st != SL_OK)
             continue;
         sl_lr_lookup_gpu g;
-        st = sl_lr_lookup_gpu_upload(&g, &lk, &err);
+        st = sl_lr_lookup_gpu_init(&g, &lk, &err);
         SL_CHECK_MSG(st == SL_OK, "%s", err.message);
         for (int slot = 0; slot < 3 && st == SL_OK; slot++) {
             if (slot == 2 && lk.kind == SL_LR_LOOKUP_OCTREE)
@@ -112,8 +112,8 @@ static void check_volume(const char *name, const sl_lr_volume *lr, int texture, 
                    cases[c].forest, slot == 2 ? "heads3d" : slot ? "#define" : "uniform", g.bytes, bad, PROBES);
         }
         SL_CHECK(sl_gl_check_errors("lr look-up probe", &err) == SL_OK);
-        sl_lr_lookup_gpu_free(&g);
-        sl_lr_lookup_free(&lk);
+        sl_lr_lookup_gpu_deinit(&g);
+        sl_lr_lookup_deinit(&lk);
     }
     glDeleteBuffers(2, bufs);
     free(pts);
