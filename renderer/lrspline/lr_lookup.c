@@ -130,18 +130,17 @@ sl_status sl_lr_lookup_init(sl_lr_lookup *lk, const sl_lr_volume *lr, sl_lr_look
         st = sl_lr_lookup_build_forest(lk, lr, forest_axis ? forest_axis : SL_LR_FOREST_DEFAULT_AXIS, err);
         break;
     case SL_LR_LOOKUP_AUTO: {
-        /* The rule of sl_lr_lookup.h (measured by bench-lr-lookup): texture,
-         * else a compact octree, else the default k-d forest. */
+        /* The rule of sl_lr_lookup.h (measured by bench-lr-lookup): the
+         * texture where it applies, else the default k-d forest. */
         sl_err quiet;
         st = sl_lr_lookup_build_texture(lk, lr, &quiet);
-        for (int step = 0; step < 2 && (st == SL_ERR_UNSUPPORTED || st == SL_ERR_LIMIT); step++) {
+        if (st == SL_ERR_UNSUPPORTED) {
             sl_lr_lookup_deinit(lk);
             for (int d = 0; d < 3; d++) {
                 lk->lo[d] = lr->domain_lo[d];
                 lk->hi[d] = lr->domain_hi[d];
             }
-            st = step == 0 ? sl_lr_lookup_build_octree(lk, lr, lr->element_count, &quiet)
-                           : sl_lr_lookup_build_forest(lk, lr, SL_LR_FOREST_DEFAULT_AXIS, &quiet);
+            st = sl_lr_lookup_build_forest(lk, lr, SL_LR_FOREST_DEFAULT_AXIS, &quiet);
         }
         if (st != SL_OK)
             *err = quiet;

@@ -28,13 +28,14 @@
  *  kdforest — the domain cut into I x J x K regular blocks, one such k-d
  *             tree per block over the elements meeting the block; a block
  *             met by one element stores it directly (depth 0).
- *  auto     — the texture when it applies; else the octree when it applies
- *             with at most as many split cells as there are elements; else
- *             the k-d forest of SL_LR_FOREST_DEFAULT_AXIS^3 blocks. Measured
- *             by bench-lr-lookup (bench/RESULTS.md): texture fastest where it
- *             applies; on a dyadic refined mesh the compact octree beat the
- *             forest on the CPU and mostly on llvmpipe; 32^3 blocks was the
- *             best or near-best forest on all three test meshes.
+ *  auto     — the texture where it applies, else the k-d forest of
+ *             SL_LR_FOREST_DEFAULT_AXIS^3 blocks. Measured by bench-lr-lookup
+ *             (bench/RESULTS.md, llvmpipe, loaded machine): the texture is
+ *             the fastest where it applies; on the GPU the 32^3 forest beat
+ *             the octree in 2 of 3 runs on a dyadic refined mesh and one
+ *             k-d tree by 3-6x; 32^3 was best or near-best on the uniform
+ *             and dyadic refined meshes (8^3-16^3 did better on the
+ *             non-dyadic one, whose elements straddle more blocks).
  *
  * Any thread for building and CPU queries (read-only once built); the GPU
  * functions need the render thread's GL context.

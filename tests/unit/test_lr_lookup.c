@@ -103,16 +103,10 @@ static sl_status check_kind(const char *name, const sl_lr_volume *lr, const prob
 static void check_all(const char *name, const sl_lr_volume *lr, int expect_texture, int expect_octree)
 {
     {
-        /* auto: texture, else a compact octree, else the k-d forest. */
+        /* auto: the texture where it applies, else the k-d forest. */
         sl_err e0;
-        sl_lr_lookup a, o;
-        int compact = expect_octree && sl_lr_lookup_init(&o, lr, SL_LR_LOOKUP_OCTREE, 0, &e0) == SL_OK &&
-                      o.oct_count <= lr->element_count;
-        if (expect_octree && o.kind == SL_LR_LOOKUP_OCTREE)
-            sl_lr_lookup_deinit(&o);
-        sl_lr_lookup_kind want = expect_texture ? SL_LR_LOOKUP_TEXTURE
-                               : compact        ? SL_LR_LOOKUP_OCTREE
-                                                : SL_LR_LOOKUP_KDFOREST;
+        sl_lr_lookup a;
+        sl_lr_lookup_kind want = expect_texture ? SL_LR_LOOKUP_TEXTURE : SL_LR_LOOKUP_KDFOREST;
         SL_CHECK(sl_lr_lookup_init(&a, lr, SL_LR_LOOKUP_AUTO, 0, &e0) == SL_OK);
         SL_CHECK_MSG(a.kind == want, "%s: auto chose %s, expected %s", name, sl_lr_lookup_kind_name(a.kind),
                      sl_lr_lookup_kind_name(want));
