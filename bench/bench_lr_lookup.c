@@ -180,7 +180,7 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
             continue;
         }
         sl_lr_lookup_gpu g;
-        if (sl_lr_lookup_gpu_init(&g, &lk, &err) != SL_OK) {
+        if (sl_lr_lookup_gpu_init(&g, &lk, 1, &err) != SL_OK) {
             printf("| %s | GPU upload failed: %s |||||||||||||||\n", label, err.message);
             sl_lr_lookup_deinit(&lk);
             continue;
@@ -216,7 +216,7 @@ static void bench_volume(const char *name, const sl_lr_volume *lr, const options
         if (sl_lr_lookup_init(&lk, lr, vk[v], 0, &err) != SL_OK)
             continue;
         sl_lr_lookup_gpu g;
-        if (sl_lr_lookup_gpu_init(&g, &lk, &err) == SL_OK) {
+        if (sl_lr_lookup_gpu_init(&g, &lk, 1, &err) == SL_OK) {
             cpu_time(&lk, &ps[1], cpu, 1);
             size_t m[3] = {0, 0, 0};
             double t0 = gpu_time(&g, 0, &ps[1], cpu, o->repeat, &m[0]);

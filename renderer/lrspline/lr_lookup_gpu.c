@@ -45,7 +45,7 @@ static GLuint make_buffer(const void *data, size_t bytes)
     return b;
 }
 
-sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err)
+sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, int heads_texture, sl_err *err)
 {
     memset(g, 0, sizeof *g);
     g->kind = lk->kind;
@@ -106,7 +106,7 @@ sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_
     g->nodes = make_buffer(nodes, nn * sizeof *nodes);
     g->planes = make_buffer(planes, np * sizeof *planes);
     g->bytes = (nh + nn + np) * 4;
-    if (lk->kind != SL_LR_LOOKUP_OCTREE) {
+    if (heads_texture && lk->kind != SL_LR_LOOKUP_OCTREE) {
         GLint max3d = 0;
         glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
         if (g->n[0] <= max3d && g->n[1] <= max3d && g->n[2] <= max3d) {

@@ -144,9 +144,10 @@ long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
  *   binding 10 LrLookupPlanes { float lr_planes[]; } texture/forest: the
  *              cell/block planes of x (n0+1), then y (n1+1), then z (n2+1).
  *   binding 11 reserved for look-up (unused now).
- *   texture unit 8: the heads again as a GL_R32UI 3D texture n0 x n1 x n2
- *              (texture/forest/kdtree; read instead of binding 8 when the
- *              shader #defines LR_LOOKUP_HEADS_TEXTURE, as the paper does).
+ *   texture unit 8: when asked for, the heads again as a GL_R32UI 3D
+ *              texture n0 x n1 x n2 (texture/forest/kdtree; read instead of
+ *              binding 8 when the shader #defines LR_LOOKUP_HEADS_TEXTURE,
+ *              as the paper does; not faster on llvmpipe, see RESULTS.md).
  * Uniforms (set by sl_lr_lookup_gpu_bind on the given program):
  *   ivec3 lr_lookup_n; vec3 lr_lookup_lo, lr_lookup_hi (domain, rounded
  *   inwards to float); vec3 lr_lookup_origin, lr_lookup_scale (cell index
@@ -165,7 +166,7 @@ long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
 
 typedef struct sl_lr_lookup_gpu {
     unsigned int heads, nodes, planes;   /* GL buffer names */
-    unsigned int heads_texture;          /* GL texture name, 0 for the octree */
+    unsigned int heads_texture;          /* GL texture name; 0 when not asked for, or octree */
     sl_lr_lookup_kind kind;
     int n[3];
     float lo[3], hi[3], origin[3], scale[3];
@@ -173,9 +174,10 @@ typedef struct sl_lr_lookup_gpu {
 } sl_lr_lookup_gpu;
 
 /* Uploads a built structure into GL objects owned by *g (render thread);
- * SL_ERR_GPU on a GL error, SL_ERR_NOMEM; on failure *g owns nothing.
- * deinit is safe on a zeroed *g. */
-sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, sl_err *err);
+ * heads_texture: also the 3D heads texture (for LR_LOOKUP_HEADS_TEXTURE
+ * shaders; skipped above GL_MAX_3D_TEXTURE_SIZE). SL_ERR_GPU on a GL error,
+ * SL_ERR_NOMEM; on failure *g owns nothing. deinit is safe on a zeroed *g. */
+sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, int heads_texture, sl_err *err);
 /* Binds the buffers to 8..10 and the heads texture to unit 8 and sets the
  * uniforms of `program` (which is made current). */
 void sl_lr_lookup_gpu_bind(const sl_lr_lookup_gpu *g, unsigned int program);

@@ -84,7 +84,7 @@ static void check_volume(const char *name, const sl_lr_volume *lr, int texture, 
         if (st != SL_OK)
             continue;
         sl_lr_lookup_gpu g;
-        st = sl_lr_lookup_gpu_init(&g, &lk, &err);
+        st = sl_lr_lookup_gpu_init(&g, &lk, 1, &err);
         SL_CHECK_MSG(st == SL_OK, "%s", err.message);
         for (int slot = 0; slot < 3 && st == SL_OK; slot++) {
             if (slot == 2 && lk.kind == SL_LR_LOOKUP_OCTREE)
