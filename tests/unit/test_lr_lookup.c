@@ -5,7 +5,7 @@
  * strongly locally refined element meshes (tests/support/lr_test_volumes.h:
  * boxes split in 8 near a point down to 1:2^10 and near a sphere; split at
  * the middle = dyadic, or at 0.4 = non-dyadic). For each, 10^6 probe points
- * (2*10^5 in sanitizer builds)
+ * (10^5 in sanitizer builds)
  * (uniform, on element faces/edges/corners, beside them, on the domain's
  * faces/edges/corners, just outside) must give exactly the reference element
  * (or -1) for every applicable structure and several forest sizes. Refusals:
@@ -23,13 +23,13 @@
 #include "lrspline/sl_lr_lookup.h"
 #include "sl_test.h"
 
-/* 10^6 probes per volume; 2*10^5 under a sanitizer (20x slower there, and
+/* 10^6 probes per volume; 10^5 under a sanitizer (20x slower there, and
  * the ctest timeout is 300 s on a shared machine). */
 #if defined(__SANITIZE_ADDRESS__)
-#define PROBES 200000
+#define PROBES 100000
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
-#define PROBES 200000
+#define PROBES 100000
 #endif
 #endif
 #ifndef PROBES
