@@ -127,8 +127,11 @@ static sl_status program_for(sl_flow_gpu *g, const sl_flow_options *o, sl_flow_p
     append_list(defines, sizeof defines, a, S * S, dbl);
     strncat(defines, "\n#define SL_TAB_B ", sizeof defines - strlen(defines) - 1);
     append_list(defines, sizeof defines, m->b, S, dbl);
-    strncat(defines, "\n#define SL_TAB_E ", sizeof defines - strlen(defines) - 1);
-    append_list(defines, sizeof defines, m->e, S, dbl);
+    double dif[SL_FLOW_MAX_STAGES];
+    for (int i = 0; i < S; i++)
+        dif[i] = m->b[i] - m->e[i];
+    strncat(defines, "\n#define SL_TAB_D ", sizeof defines - strlen(defines) - 1);
+    append_list(defines, sizeof defines, dif, S, dbl);
     strncat(defines, "\n", sizeof defines - strlen(defines) - 1);
     sl_program_desc d = {.compute = "flow/flow_trace_regular.comp.glsl", .defines = defines,
                          .label = "flow_trace"};

@@ -5,10 +5,13 @@
 // / field_d() before it. Defines from flow_gpu.c: SL_STAGES, SL_EMBEDDED
 // (embedded order, 0 = fixed step), SL_MODE (0 fixed, 1 heuristic = fixed
 // h = step * local size, a constant on a regular field, 2 adaptive) and the
-// tableau SL_TAB_A (SL_STAGES^2, row-major), SL_TAB_B, SL_TAB_E as REAL
-// literals printed from sl_flow_methods. Differences from the CPU: the
-// step factor (tol/err)^(1/(q+1)) uses float pow (GLSL has no double pow),
-// so adaptive step sequences may differ in the last bits.
+// tableau SL_TAB_A (SL_STAGES^2, row-major), SL_TAB_B, SL_TAB_D (b - e,
+// subtracted in C: Mesa folded B[i] - E[i] at float precision) as REAL
+// literals printed from sl_flow_methods. Difference from the CPU: the
+// step factor (tol/err)^(1/(q+1)) is root_n (float pow refined by Newton in
+// double), so a double step size may differ from libm's pow by an ulp.
+// Inexact constants are written as double literals (0.9lf), so double
+// variants use the same numbers as the C code.
 // Output per sample: 8 REAL (t, x, y, z, vx, vy, vz, 0) at
 // (line * max_samples + i) * 8; per line 4 uint (count, stop, rejected, forced).
 layout(local_size_x = 64) in;
@@ -33,7 +36,7 @@ uniform REAL u_step, u_tol, u_h_min, u_h_max, u_t_max, u_min_speed, u_h0;
 
 const REAL A[SL_STAGES * SL_STAGES] = REAL[](SL_TAB_A);
 const REAL B[SL_STAGES] = REAL[](SL_TAB_B);
-const REAL E[SL_STAGES] = REAL[](SL_TAB_E);
+const REAL D[SL_STAGES] = REAL[](SL_TAB_D); // b - e, computed in C
 
 uint g_line, g_count;
 
@@ -83,11 +86,26 @@ int rk_step(VEC3 x, VEC3 k0, REAL h, out VEC3 xn, out REAL err_norm)
     VEC3 s = VEC3(0), e = VEC3(0);
     for (int i = 0; i < SL_STAGES; i++) {
         s += B[i] * k[i];
-        e += (B[i] - E[i]) * k[i];
+        e += D[i] * k[i];
     }
     xn = x + h * s;
     err_norm = SL_EMBEDDED != 0 ? norm3(h * e) : REAL(0);
     return inside(xn) ? 0 : -1;
+}
+
+// r^(1/n) for r in [1e-10, 1e10]: float pow, refined in double by three
+// Newton steps on y^n = r (GLSL has no double pow), so the step factor
+// agrees with the CPU's libm pow to about an ulp.
+REAL root_n(REAL r, int n)
+{
+    REAL y = REAL(pow(float(r), 1.0 / float(n)));
+#if SL_PREC != 0
+    for (int it = 0; it < 3; it++) {
+        REAL y1 = n == 2 ? y : n == 3 ? y * y : n == 4 ? y * y * y : (y * y) * (y * y);
+        y = y - (y1 * y - r) / (REAL(n) * y1);
+    }
+#endif
+    return y;
 }
 
 // Time along v from x to the first face (coordinate set exactly); -1: v = 0.
@@ -160,9 +178,9 @@ int trace(out uint rejected, out uint forced)
             }
             if (SL_MODE != 2)
                 break;
-            REAL fac = e > REAL(0) ? REAL(0.9 * pow(float(u_tol / e), 1.0 / float(SL_EMBEDDED + 1)))
+            REAL fac = e > REAL(0) ? REAL(0.9lf) * root_n(clamp(u_tol / e, REAL(1e-10lf), REAL(1e10lf)), SL_EMBEDDED + 1)
                                    : REAL(5);
-            fac = clamp(fac, REAL(0.2), REAL(5));
+            fac = clamp(fac, REAL(0.2lf), REAL(5));
             REAL hn = clamp(h * fac, u_h_min, u_h_max);
             if (e <= u_tol || h <= u_h_min) {
                 if (e > u_tol)
@@ -178,7 +196,7 @@ int trace(out uint rejected, out uint forced)
         if (boundary) {
             REAL lo = REAL(0), hi = h;
             VEC3 xl = x;
-            for (int it = 0; it < 64 && hi - lo > REAL(1e-13) * h; it++) {
+            for (int it = 0; it < 64 && hi - lo > REAL(1e-13lf) * h; it++) {
                 REAL mid = REAL(0.5) * (lo + hi), em;
                 VEC3 xm;
                 int s = rk_step(x, v, mid, xm, em);

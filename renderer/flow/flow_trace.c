@@ -253,7 +253,9 @@ static int trace_line(const sl_flow_field *f, const double seed[3], const sl_flo
             }
             if (o->mode != SL_FLOW_STEP_ADAPTIVE)
                 break;
-            double fac = e > 0.0 ? 0.9 * pow(o->tol / e, 1.0 / (double)(m->embedded_order + 1)) : 5.0;
+            double ratio = e > 0.0 ? o->tol / e : 1e10;
+            ratio = ratio < 1e-10 ? 1e-10 : ratio > 1e10 ? 1e10 : ratio; /* fac is clamped below anyway */
+            double fac = e > 0.0 ? 0.9 * pow(ratio, 1.0 / (double)(m->embedded_order + 1)) : 5.0;
             if (fac < 0.2)
                 fac = 0.2;
             if (fac > 5.0)
