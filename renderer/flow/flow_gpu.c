@@ -230,7 +230,7 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
                 (float)f->origin[2]);
     glUniform3f(glGetUniformLocation(program, "u_spacing_f"), (float)f->spacing[0], (float)f->spacing[1],
                 (float)f->spacing[2]);
-    if (precision == SL_FLOW_DOUBLE) {
+    if (precision != SL_FLOW_SINGLE) {
         glUniform3d(glGetUniformLocation(program, "u_origin_d"), f->origin[0], f->origin[1], f->origin[2]);
         glUniform3d(glGetUniformLocation(program, "u_spacing_d"), f->spacing[0], f->spacing[1], f->spacing[2]);
     }

@@ -4,8 +4,10 @@
  * stop reasons as the CPU reference sl_flow_trace (sl_flow.h).
  *
  * Precision: single = float everywhere; mixed = double for positions,
- * time and the RK update, the field evaluated in float at the stage point
- * rounded to float; double = double everywhere, the trilinear included
+ * time and the RK update, the field evaluated in float at local
+ * coordinates (cell index and weights found in double, as the paper
+ * evaluates in element-local coordinates; an LR field_m would do the same
+ * per element); double = double everywhere, the trilinear included
  * (texel values are floats, converted exactly). Mixed and double need
  * doubles in GLSL (core in 4.50, GL_ARB_gpu_shader_fp64; llvmpipe has them).
  * Regular vector fields only, as an RGBA32F 3D texture sampled by

@@ -2,7 +2,7 @@
 // one invocation per streamline (sl_flow.h states the rules: step modes,
 // error control, boundary bisection and the Euler step to the face, stop
 // reasons). Expects REAL, VEC3, flow_finite3 (flow_real.glsl) and field()
-// / field_d() before it. Defines from flow_gpu.c: SL_STAGES, SL_EMBEDDED
+// / field_m() / field_d() before it. Defines from flow_gpu.c: SL_STAGES, SL_EMBEDDED
 // (embedded order, 0 = fixed step), SL_MODE (0 fixed, 1 heuristic = fixed
 // h = step * local size, a constant on a regular field, 2 adaptive) and the
 // tableau SL_TAB_A (SL_STAGES^2, row-major), SL_TAB_B, SL_TAB_D (b - e,
@@ -29,7 +29,7 @@ uniform REAL u_step, u_tol, u_h_min, u_h_max, u_t_max, u_min_speed, u_h0;
 #if SL_PREC == 0
 #define FIELD(p) field(p)
 #elif SL_PREC == 1
-#define FIELD(p) dvec3(field(vec3(p)))
+#define FIELD(p) dvec3(field_m(p))
 #else
 #define FIELD(p) field_d(p)
 #endif

@@ -1,9 +1,10 @@
 // flow_real.glsl — the number types of one precision variant (flow_gpu.h):
 // SL_PREC 0 single: REAL float, positions and field in float;
 // 1 mixed: REAL double for positions, time and the RK update, the field in
-// float (FIELD converts the stage point to float and back);
+// float at local coordinates found in double (field_m);
 // 2 double: everything in double (field_d). The field file included after
-// this one defines field(vec3) and, for SL_PREC 2, field_d(dvec3). Doubles
+// this one defines field(vec3), for SL_PREC 1 field_m(dvec3) (float
+// evaluation, local coordinates from the double point) and for 2 field_d(dvec3). Doubles
 // are core in GLSL 4.50 (GL_ARB_gpu_shader_fp64); the C side checks the GL.
 #if SL_PREC == 0
 #define REAL float
