@@ -18,7 +18,9 @@
  * ... as base steps) in mixed precision on the GPU. Every row also has the
  * CPU double run's ms. GPU ms: wall time of the dispatch to glFinish (each
  * variant run once before, so shader compilation is not timed), the median
- * of 3. Writes the Markdown tables to stdout and one SVG plot (log E against
+ * of 3. `cut`: lines stopped by max_samples (4096) before t_max or the
+ * boundary — their E covers only the part traced, so such rows are not
+ * comparable (the SVG leaves them out). Writes the Markdown tables to stdout and one SVG plot (log E against
  * log ms) per figure and field into --out DIR (default bench-out).
  * Usage: bench-streamlines [--out DIR] [--only helix|abc] [--quick]
  * Main thread owns the GL context.
@@ -98,6 +100,7 @@ typedef struct row {
     const char *param_name;
     double E, E_true, gpu_ms, cpu_ms;
     size_t samples;
+    size_t truncated;            /* lines stopped by max_samples before t_max / the boundary */
 } row;
 
 #define MAX_ROWS 256
@@ -133,8 +136,11 @@ static int run_one(sl_flow_gpu *g, bench_field *bf, const sl_flow_result *ref, c
     exact_ctx ec = {bf};
     r->E_true = bf->exact ? sl_flow_error(&res, NULL, helix_exact, &ec) : NAN;
     r->samples = 0;
-    for (size_t j = 0; j < res.line_count; j++)
+    r->truncated = 0;
+    for (size_t j = 0; j < res.line_count; j++) {
         r->samples += res.lines[j].count;
+        r->truncated += res.lines[j].stop == SL_FLOW_STOP_SAMPLES;
+    }
     sl_flow_result_free(&res);
     sl_flow_result cpu;
     double t0 = sl_clock_ms();
@@ -157,7 +163,7 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
     }
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
     for (int i = 0; i < n; i++) {
-        if (rows[i].fig != fig || !(rows[i].E > 0) || !(rows[i].gpu_ms > 0))
+        if (rows[i].fig != fig || !(rows[i].E > 0) || !(rows[i].gpu_ms > 0) || rows[i].truncated)
             continue;
         double x = log10(rows[i].gpu_ms), y = log10(rows[i].E);
         x0 = fmin(x0, x), x1 = fmax(x1, x), y0 = fmin(y0, y), y1 = fmax(y1, y);
@@ -197,7 +203,8 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
                 dashed ? " stroke-dasharray='5,3'" : "");
         for (int k = i; k < n; k++)
             if (rows[k].fig == fig && strcmp(rows[k].label, rows[i].label) == 0 &&
-                strcmp(rows[k].precision, rows[i].precision) == 0 && rows[k].E > 0 && rows[k].gpu_ms > 0)
+                strcmp(rows[k].precision, rows[i].precision) == 0 && rows[k].E > 0 && rows[k].gpu_ms > 0 &&
+                !rows[k].truncated)
                 fprintf(f, "%.1f,%.1f ", PX(log10(rows[k].gpu_ms)), PY(log10(rows[k].E)));
         fprintf(f, "'/>\n");
         fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='%s' stroke-width='2'%s/><text x='%g' y='%g'>%s %s</text>\n",
@@ -215,14 +222,14 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
 static void print_table(const bench_field *bf, const row *rows, int n, int fig)
 {
     printf("\n### %s — Fig. %d analogue (%zu lines, t_max %g)\n\n", bf->name, fig, bf->seed_count, bf->t_max);
-    printf("| solver | precision | %s | samples | E (Eq. 7, vs RKF5 h=1e-4) |%s GPU ms | CPU ms (double) |\n",
+    printf("| solver | precision | %s | samples | cut | E (Eq. 7, vs RKF5 h=1e-4) |%s GPU ms | CPU ms (double) |\n",
            fig == 9 ? "step h" : "tol / H", bf->exact ? " E vs exact |" : "");
-    printf("|---|---|---|---|---|%s---|---|\n", bf->exact ? "---|" : "");
+    printf("|---|---|---|---|---|---|%s---|---|\n", bf->exact ? "---|" : "");
     for (int i = 0; i < n; i++) {
         if (rows[i].fig != fig)
             continue;
-        printf("| %s | %s | %s %.3g | %zu | %.3g |", rows[i].label, rows[i].precision, rows[i].param_name,
-               rows[i].param, rows[i].samples, rows[i].E);
+        printf("| %s | %s | %s %.3g | %zu | %zu | %.3g |", rows[i].label, rows[i].precision, rows[i].param_name,
+               rows[i].param, rows[i].samples, rows[i].truncated, rows[i].E);
         if (bf->exact)
             printf(" %.3g |", rows[i].E_true);
         printf(" %.2f | %.2f |\n", rows[i].gpu_ms, rows[i].cpu_ms);

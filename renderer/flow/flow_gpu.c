@@ -1,8 +1,8 @@
 /* flow_gpu.c — the compute-shader streamline driver (flow_gpu.h): field
- * texture, per-variant programs (the tableau printed as GLSL literals from
- * sl_flow_methods, %.17e with lf for doubles, so both paths run the same
- * coefficients), seed / sample / info buffers, dispatch, read-back. Render
- * thread only.
+ * texture, one program per precision, the tableau of sl_flow_methods as
+ * uniforms (doubles for mixed / double, so both paths run the same
+ * coefficients; b - e subtracted here), seed / sample / info buffers,
+ * dispatch, read-back. Render thread only.
  */
 #include <math.h>
 #include <stdio.h>
@@ -13,7 +13,7 @@
 #include "../gpu/sl_gpu.h"
 #include "flow_gpu.h"
 
-#define VARIANTS (SL_FLOW_SOLVER_COUNT * 3 * 3)
+#define VARIANTS 3                 /* one program per precision */
 
 struct sl_flow_gpu {
     sl_flow_field field;          /* copy; volume pointer not used after create */
@@ -94,52 +94,54 @@ void sl_flow_gpu_destroy(sl_flow_gpu *g)
     free(g);
 }
 
-static void append_list(char *buf, size_t cap, const double *v, int n, int dbl)
+static sl_status program_for(sl_flow_gpu *g, sl_flow_precision p, GLuint *program, sl_err *err)
 {
-    size_t len = strlen(buf);
-    for (int i = 0; i < n && len < cap; i++) {
-        int w = snprintf(buf + len, cap - len, dbl ? "%s%.17elf" : "%s%.9e", i ? ", " : "", v[i]);
-        if (w < 0)
-            return;
-        len += (size_t)w;
-    }
-}
-
-static sl_status program_for(sl_flow_gpu *g, const sl_flow_options *o, sl_flow_precision p,
-                             GLuint *program, sl_err *err)
-{
-    int idx = ((int)o->solver * 3 + (int)o->mode) * 3 + (int)p;
-    if (g->programs[idx]) {
-        *program = g->programs[idx];
+    if (g->programs[p]) {
+        *program = g->programs[p];
         return SL_OK;
     }
-    const sl_flow_method *m = &sl_flow_methods[o->solver];
-    int S = m->stages, dbl = p != SL_FLOW_SINGLE;
-    double a[SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES];
-    for (int i = 0; i < S; i++)
-        for (int j = 0; j < S; j++)
-            a[i * S + j] = m->a[i][j];
-    char defines[8192];
-    snprintf(defines, sizeof defines,
-             "#define SL_PREC %d\n#define SL_STAGES %d\n#define SL_EMBEDDED %d\n#define SL_MODE %d\n"
-             "#define SL_TAB_A ",
-             (int)p, S, m->embedded_order, (int)o->mode);
-    append_list(defines, sizeof defines, a, S * S, dbl);
-    strncat(defines, "\n#define SL_TAB_B ", sizeof defines - strlen(defines) - 1);
-    append_list(defines, sizeof defines, m->b, S, dbl);
-    double dif[SL_FLOW_MAX_STAGES];
-    for (int i = 0; i < S; i++)
-        dif[i] = m->b[i] - m->e[i];
-    strncat(defines, "\n#define SL_TAB_D ", sizeof defines - strlen(defines) - 1);
-    append_list(defines, sizeof defines, dif, S, dbl);
-    strncat(defines, "\n", sizeof defines - strlen(defines) - 1);
+    char defines[64];
+    snprintf(defines, sizeof defines, "#define SL_PREC %d\n", (int)p);
     sl_program_desc d = {.compute = "flow/flow_trace_regular.comp.glsl", .defines = defines,
                          .label = "flow_trace"};
-    sl_status st = sl_gl_program_create(&d, &g->programs[idx], err);
+    sl_status st = sl_gl_program_create(&d, &g->programs[p], err);
     if (st != SL_OK)
         return st;
-    *program = g->programs[idx];
+    *program = g->programs[p];
     return SL_OK;
+}
+
+/* The tableau as uniforms, zero-padded to 6 x 6; d = b - e in double here. */
+static void set_tableau(GLuint prog, const sl_flow_method *m, int dbl)
+{
+    double a[SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES] = {0}, b[SL_FLOW_MAX_STAGES] = {0},
+           d[SL_FLOW_MAX_STAGES] = {0};
+    for (int i = 0; i < m->stages; i++) {
+        for (int j = 0; j < m->stages; j++)
+            a[i * SL_FLOW_MAX_STAGES + j] = m->a[i][j];
+        b[i] = m->b[i];
+        d[i] = m->b[i] - m->e[i];
+    }
+    GLint la = glGetUniformLocation(prog, "u_a"), lb = glGetUniformLocation(prog, "u_b"),
+          ld = glGetUniformLocation(prog, "u_d");
+    if (dbl) {
+        glUniform1dv(la, SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES, a);
+        glUniform1dv(lb, SL_FLOW_MAX_STAGES, b);
+        glUniform1dv(ld, SL_FLOW_MAX_STAGES, d);
+    } else {
+        float fa[SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES], fb[SL_FLOW_MAX_STAGES], fd[SL_FLOW_MAX_STAGES];
+        for (int i = 0; i < SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES; i++)
+            fa[i] = (float)a[i];
+        for (int i = 0; i < SL_FLOW_MAX_STAGES; i++) {
+            fb[i] = (float)b[i];
+            fd[i] = (float)d[i];
+        }
+        glUniform1fv(la, SL_FLOW_MAX_STAGES * SL_FLOW_MAX_STAGES, fa);
+        glUniform1fv(lb, SL_FLOW_MAX_STAGES, fb);
+        glUniform1fv(ld, SL_FLOW_MAX_STAGES, fd);
+    }
+    glUniform1i(glGetUniformLocation(prog, "u_stages"), m->stages);
+    glUniform1i(glGetUniformLocation(prog, "u_embedded"), m->embedded_order);
 }
 
 static void uniform_real(GLuint prog, const char *name, double v, int dbl)
@@ -191,7 +193,7 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
                           "%zu seeds x %zu samples need %zu bytes, above this GPU's storage block limit %lld",
                           seed_count, max_samples, sample_bytes, (long long)max_block);
     GLuint program;
-    st = program_for(g, o, precision, &program, err);
+    st = program_for(g, precision, &program, err);
     if (st != SL_OK)
         return st;
 
@@ -234,6 +236,8 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
         glUniform3d(glGetUniformLocation(program, "u_origin_d"), f->origin[0], f->origin[1], f->origin[2]);
         glUniform3d(glGetUniformLocation(program, "u_spacing_d"), f->spacing[0], f->spacing[1], f->spacing[2]);
     }
+    set_tableau(program, m, dbl);
+    glUniform1i(glGetUniformLocation(program, "u_mode"), (int)o->mode);
     glUniform1ui(glGetUniformLocation(program, "u_lines"), (GLuint)seed_count);
     glUniform1ui(glGetUniformLocation(program, "u_max_samples"), (GLuint)max_samples);
     uniform_vec3(program, "u_lo", f->lo, dbl);

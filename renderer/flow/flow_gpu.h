@@ -43,7 +43,7 @@ void sl_flow_gpu_destroy(sl_flow_gpu *g); /* NULL is fine */
 
 /* Traces one line per seed; *out as sl_flow_trace (samples converted to
  * double; `evaluations` is not counted on the GPU). Programs are compiled on
- * first use per (solver, mode, precision) and kept. compute_ms (may be NULL):
+ * first use per precision and kept. compute_ms (may be NULL):
  * wall time of the dispatch to glFinish, without upload, compile or
  * read-back. SL_ERR_INVALID for bad options, SL_ERR_UNSUPPORTED for mixed /
  * double without GL doubles, SL_ERR_LIMIT when the sample buffer would

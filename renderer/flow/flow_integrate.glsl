@@ -2,12 +2,9 @@
 // one invocation per streamline (sl_flow.h states the rules: step modes,
 // error control, boundary bisection and the Euler step to the face, stop
 // reasons). Expects REAL, VEC3, flow_finite3 (flow_real.glsl) and field()
-// / field_m() / field_d() before it. Defines from flow_gpu.c: SL_STAGES, SL_EMBEDDED
-// (embedded order, 0 = fixed step), SL_MODE (0 fixed, 1 heuristic = fixed
-// h = step * local size, a constant on a regular field, 2 adaptive) and the
-// tableau SL_TAB_A (SL_STAGES^2, row-major), SL_TAB_B, SL_TAB_D (b - e,
-// subtracted in C: Mesa folded B[i] - E[i] at float precision) as REAL
-// literals printed from sl_flow_methods. Difference from the CPU: the
+// / field_m() / field_d() before it. The tableau and the step mode are
+// uniforms (so one program per precision, and shaders-check compiles it
+// without defines). Difference from the CPU: the
 // step factor (tol/err)^(1/(q+1)) is root_n (float pow refined by Newton in
 // double), so a double step size may differ from libm's pow by an ulp.
 // Inexact constants are written as double literals (0.9lf), so double
@@ -34,9 +31,15 @@ uniform REAL u_step, u_tol, u_h_min, u_h_max, u_t_max, u_min_speed, u_h0;
 #define FIELD(p) field_d(p)
 #endif
 
-const REAL A[SL_STAGES * SL_STAGES] = REAL[](SL_TAB_A);
-const REAL B[SL_STAGES] = REAL[](SL_TAB_B);
-const REAL D[SL_STAGES] = REAL[](SL_TAB_D); // b - e, computed in C
+// The Butcher tableau (sl_flow_methods): a row-major 6 x 6, b, and d = b - e
+// (subtracted in C), zero-padded; stages, embedded order (0: fixed step)
+// and step mode (0 fixed, 1 heuristic = fixed h = step * local size, a
+// constant on a regular field, 2 adaptive).
+#define SL_MAX_STAGES 6
+uniform REAL u_a[SL_MAX_STAGES * SL_MAX_STAGES];
+uniform REAL u_b[SL_MAX_STAGES];
+uniform REAL u_d[SL_MAX_STAGES];
+uniform int u_stages, u_embedded, u_mode;
 
 uint g_line, g_count;
 
@@ -68,14 +71,14 @@ REAL norm3(VEC3 v)
 // 0: xn (and err_norm) set; -1 a stage or the result outside; -2 non-finite field.
 int rk_step(VEC3 x, VEC3 k0, REAL h, out VEC3 xn, out REAL err_norm)
 {
-    VEC3 k[SL_STAGES];
+    VEC3 k[SL_MAX_STAGES];
     k[0] = k0;
     xn = x;
     err_norm = REAL(0);
-    for (int i = 1; i < SL_STAGES; i++) {
+    for (int i = 1; i < u_stages; i++) {
         VEC3 s = VEC3(0);
         for (int j = 0; j < i; j++)
-            s += A[i * SL_STAGES + j] * k[j];
+            s += u_a[i * SL_MAX_STAGES + j] * k[j];
         VEC3 p = x + h * s;
         if (!inside(p))
             return -1;
@@ -84,12 +87,12 @@ int rk_step(VEC3 x, VEC3 k0, REAL h, out VEC3 xn, out REAL err_norm)
             return -2;
     }
     VEC3 s = VEC3(0), e = VEC3(0);
-    for (int i = 0; i < SL_STAGES; i++) {
-        s += B[i] * k[i];
-        e += D[i] * k[i];
+    for (int i = 0; i < u_stages; i++) {
+        s += u_b[i] * k[i];
+        e += u_d[i] * k[i];
     }
     xn = x + h * s;
-    err_norm = SL_EMBEDDED != 0 ? norm3(h * e) : REAL(0);
+    err_norm = u_embedded != 0 ? norm3(h * e) : REAL(0);
     return inside(xn) ? 0 : -1;
 }
 
@@ -158,7 +161,7 @@ int trace(out uint rejected, out uint forced)
             return STOP_SAMPLES;
         if (norm3(v) < u_min_speed)
             return STOP_STAGNANT;
-        REAL h = SL_MODE == 2 ? h_adapt : u_step;
+        REAL h = u_mode == 2 ? h_adapt : u_step;
         REAL remaining = u_t_max - t;
         bool last = false;
         if (h >= remaining) {
@@ -176,9 +179,9 @@ int trace(out uint rejected, out uint forced)
                 boundary = true;
                 break;
             }
-            if (SL_MODE != 2)
+            if (u_mode != 2)
                 break;
-            REAL fac = e > REAL(0) ? REAL(0.9lf) * root_n(clamp(u_tol / e, REAL(1e-10lf), REAL(1e10lf)), SL_EMBEDDED + 1)
+            REAL fac = e > REAL(0) ? REAL(0.9lf) * root_n(clamp(u_tol / e, REAL(1e-10lf), REAL(1e10lf)), u_embedded + 1)
                                    : REAL(5);
             fac = clamp(fac, REAL(0.2lf), REAL(5));
             REAL hn = clamp(h * fac, u_h_min, u_h_max);

@@ -1,6 +1,6 @@
 /* flow_methods.c — the Butcher tableaux of every streamline solver, one
  * table (sl_flow.h lists them). The compute shader receives these same
- * numbers (flow_gpu.c prints them with %.17g), so CPU and GPU run identical
+ * numbers (flow_gpu.c sets them as uniforms, doubles where the variant is), so CPU and GPU run identical
  * coefficients. Sources: Hairer, Norsett, Wanner, "Solving ODEs I" (rk3,
  * rk4, 3/8 rule, Fehlberg 4(5)); Bogacki & Shampine 1989. Constant data.
  */

@@ -8,7 +8,7 @@
  * lr_volume; none of those owns them.
  *
  * Pieces: sl_flow_field (sampling, CPU, double), the Runge-Kutta table
- * sl_flow_methods (one Butcher tableau per solver, also pasted into the
+ * sl_flow_methods (one Butcher tableau per solver, also handed to the
  * compute shader so both paths run the same coefficients), sl_flow_trace
  * (the CPU double reference integrator), seeds, and the result as an
  * sl_lines (positions + velocities = Hermite data for renderer/tubes).

@@ -1,7 +1,7 @@
 # sightline-trace (renderer/flow, issue 15): a helix field as an NRRD vector
 # volume (tests/render/flow/flow_check.c writes it; trilinear is exact on
 # it), traced on the CPU and through the compute shader. CPU rk4 h = 0.05
-# to t = 3 lies within 1e-5 of the exact helix (measured 2.7e-7), with the
+# to t = 3 lies within 1e-5 of the exact helix (measured 2.0e-7), with the
 # exact CSV columns, line ids, times ending at t_max and velocities equal to
 # the field; GPU double equals the CPU to 1e-12 of the box, single and mixed
 # to 1e-5; a --seed-box of 10 gives 10 lines; usage errors exit 2 with a
