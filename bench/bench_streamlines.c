@@ -3,7 +3,8 @@
  * Fig. 9 and 10).
  *
  * Fields (regular vector volumes, so the GPU can trace them): `helix`, the
- * rotation v = (-y, x, 0.5) at 33x33x17 voxel centres on [-2,2]^2 x [-1,3]
+ * rotation v = (-y, x, 0.5) at 33x33x17 voxel centres on [-2,2]^2 x [-1,1]
+ * (lines leave through z = 1 before t_max, so the boundary clip is timed too)
  * (trilinear reproduces it exactly, so the true error is known: x(t) in
  * closed form), and `abc`, the ABC flow (A = sqrt 3, B = sqrt 2, C = 1)
  * sampled at 33^3 centres on [0, 2 pi]^3 (no generator makes vector volumes,
