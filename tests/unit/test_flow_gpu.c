@@ -8,8 +8,10 @@
  * <= 1e-5, the same stop reasons and sample counts (single/mixed: +-1
  * sample, a float time can land a hair short of t_max). Adaptive solvers:
  * the GPU's step sequence differs from the CPU's (measured: the second
- * step already differs at ~1e-7 relative in double for bs and rkf45, not
- * for he; the cause is not found yet), so each is checked against a fine
+ * step differed at ~1e-7 relative in double for bs and rkf45 while the
+ * tableau was GLSL const arrays; with uniforms they agree to 3e-13 on the
+ * helix volume (sightline-trace), but on this ABC volume bs and rkf45 in
+ * double still part somewhere, cause not found), so each is checked against a fine
  * reference (RKF5, h = 1e-3, double) interpolated by cubic Hermite at its
  * own times: GPU error <= 2 x the CPU adaptive run's error + 1e-9 (double)
  * or + 1e-5 (single, mixed), and the same stop reasons. Also: the LR refusal, mixed/double
