@@ -144,7 +144,11 @@ sl_status sl_shader_expand(const sl_embedded_file *file, const char *defines, sl
 {
     memset(out, 0, sizeof *out);
     expansion x = {0};
-    text_printf(&x.out, "#version 450 core\n%s", defines ? defines : "");
+    /* Appended, not printed: text_printf truncates at 512 bytes and defines
+     * may be longer (flow/ pastes Butcher tableaux). */
+    text_printf(&x.out, "#version 450 core\n");
+    if (defines)
+        text_append(&x.out, defines, strlen(defines));
     sl_status st = expand(&x, file, 0, err);
     if (st == SL_OK && x.out.failed)
         st = sl_err_set(err, SL_ERR_NOMEM, "out of memory expanding %s", file->path);

@@ -1,0 +1,56 @@
+/* flow_gpu.h — streamline integration in a compute shader (issue 15
+ * "Streamlines", paper sec. 5.1 and 5.6: one invocation per streamline,
+ * single | mixed | double precision), the same solvers, step rules and
+ * stop reasons as the CPU reference sl_flow_trace (sl_flow.h).
+ *
+ * Precision: single = float everywhere; mixed = double for positions,
+ * time and the RK update, the field evaluated in float at local
+ * coordinates (cell index and weights found in double, as the paper
+ * evaluates in element-local coordinates; an LR field_m would do the same
+ * per element); double = double everywhere, the trilinear included
+ * (texel values are floats, converted exactly). Mixed and double need
+ * doubles in GLSL (core in 4.50, GL_ARB_gpu_shader_fp64; llvmpipe has them).
+ * Regular vector fields only, as an RGBA32F 3D texture sampled by
+ * texelFetch with the CPU's trilinear order of operations
+ * (flow_field_regular.glsl). LR fields: SL_ERR_UNSUPPORTED "not yet" until
+ * the Bézier evaluation (lrspline/lr_bezier.glsl) and the element look-up
+ * (lr_lookup.glsl) are wired as a flow_field_lr.glsl defining
+ * field()/field_d() and a flow_trace_lr.comp.glsl of three includes.
+ * Render thread only, GL context current. Not done here: drawing (the
+ * result goes through sl_flow_result_to_dataset to renderer/tubes).
+ */
+#ifndef FLOW_GPU_H
+#define FLOW_GPU_H
+
+#include <epoxy/gl.h>
+
+#include "sl_flow.h"
+
+typedef enum sl_flow_precision {
+    SL_FLOW_SINGLE = 0, SL_FLOW_MIXED = 1, SL_FLOW_DOUBLE = 2
+} sl_flow_precision;
+/* "single" | "mixed" | "double"; -1 when unknown. */
+int sl_flow_precision_find(const char *name);
+const char *sl_flow_precision_name(sl_flow_precision p);
+
+typedef struct sl_flow_gpu sl_flow_gpu;
+
+/* Uploads the field. SL_ERR_UNSUPPORTED for LR and analytic fields (the
+ * message says which), SL_ERR_GPU on GL failure. The field's volume is
+ * borrowed only during the call. */
+sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err);
+void sl_flow_gpu_destroy(sl_flow_gpu *g); /* NULL is fine */
+
+/* Traces one line per seed; *out as sl_flow_trace (samples converted to
+ * double; `evaluations` is not counted on the GPU). Programs are compiled on
+ * first use per precision and kept. compute_ms (may be NULL):
+ * wall time of the dispatch to glFinish, without upload, compile or
+ * read-back. SL_ERR_INVALID for bad options, SL_ERR_UNSUPPORTED for mixed /
+ * double without GL doubles, SL_ERR_LIMIT when the sample buffer would
+ * exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE or SL_MAX_VERTICES samples,
+ * SL_ERR_GPU on compile or GL errors. */
+sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_count,
+                            const sl_flow_options *o, sl_flow_precision precision,
+                            sl_flow_result *out, double *compute_ms, sl_err *err);
+
+#endif
