@@ -537,6 +537,8 @@ sl_status sl_load_lr(const uint8_t *data, size_t size, const char *path, sl_data
     st = walk(&c, &h, lr, stamp, &again, err);
     if (st == SL_OK)
         st = sl_lr_finish(lr, err);
+    if (st == SL_OK)
+        st = sl_lr_index(lr, err);
     if (st != SL_OK)
         goto fail;
     free(stamp);

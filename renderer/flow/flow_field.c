@@ -2,7 +2,8 @@
  * (sl_flow.h: the voxel-centre convention, the trilinear order of
  * operations the compute shader repeats, the heuristic local size).
  * LR look-up: the cursor's element is tried first under the element rule,
- * then sl_lr_find_element_linear (a k-d forest is for the lead to plug in).
+ * then sl_lr_find_element (the model's k-d forest or texture when it carries
+ * one, sl_lr_index; else a linear search).
  * Any thread; no GL; the field is read-only.
  */
 #include <math.h>
@@ -96,7 +97,7 @@ static long lr_element(const sl_lr_volume *lr, const double p[3], sl_flow_cursor
     if (cursor && cursor->element >= 0 && (size_t)cursor->element < lr->element_count &&
         lr_in_element(lr, cursor->element, p))
         return cursor->element;
-    long e = sl_lr_find_element_linear(lr, p);
+    long e = sl_lr_find_element(lr, p);
     if (cursor)
         cursor->element = e;
     return e;

@@ -57,7 +57,7 @@ sl_status sl_lr_eval(const sl_lr_volume *lr, const double p[3], long element,
                      double *value, double *gradient, sl_err *err)
 {
     if (element < 0)
-        element = sl_lr_find_element_linear(lr, p);
+        element = sl_lr_find_element(lr, p);
     if (element < 0 || (size_t)element >= lr->element_count)
         return sl_err_set(err, SL_ERR_INVALID, "point (%g, %g, %g) is outside the LR-spline's domain",
                           p[0], p[1], p[2]);

@@ -346,6 +346,7 @@ static sl_status copy_model(const sl_lr_volume *in, sl_lr_volume *out, sl_err *e
     out->meshrects = m;
     out->elements = e;
     out->element_basis = eb;
+    out->index = NULL; /* the copy has no look-up of its own */
     memcpy(b, in->basis, in->basis_count * sizeof *b);
     memcpy(m, in->meshrects, in->meshrect_count * sizeof *m);
     memcpy(e, in->elements, in->element_count * sizeof *e);

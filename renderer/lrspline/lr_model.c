@@ -2,6 +2,7 @@
  * volume model, and the linear element search (see sl_lr.h).
  * Any thread; no GL. */
 #include "sl_lr.h"
+#include "lr_index.h"
 
 #include <float.h>
 #include <math.h>
@@ -45,6 +46,7 @@ void sl_lr_free(sl_lr_volume *lr)
 {
     if (!lr)
         return;
+    sl_lr_drop_index(lr);
     free(lr->basis);
     free(lr->meshrects);
     free(lr->elements);
@@ -109,6 +111,7 @@ static void add_value_sample(sl_lr_volume *lr, const double *v)
 
 sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err)
 {
+    sl_lr_drop_index(lr);
     for (int d = 0; d < 3; d++)
         if (lr->order[d] < 1 || lr->order[d] > SL_LR_MAX_ORDER)
             return sl_err_set(err, SL_ERR_UNSUPPORTED, "order %d in %c is outside 1..%d (degree up to %d)",

@@ -75,6 +75,9 @@ typedef struct sl_lr_volume {
     double domain_lo[3], domain_hi[3];    /* union of the element boxes */
     double min_side[3], max_side[3];      /* smallest and largest element side per direction */
     double value_min, value_max;          /* of the value (vectors: magnitude), see sl_lr_finish */
+    /* Optional CPU element look-up (sl_lr_index; sl_lr_lookup.h), owned;
+     * NULL: sl_lr_find_element searches linearly. */
+    struct sl_lr_lookup *index;
 } sl_lr_volume;
 
 /* Allocates the arrays of an empty model (zeroed); SL_ERR_LIMIT above the
@@ -99,6 +102,17 @@ sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err);
  * The reference every look-up structure is tested against. */
 long sl_lr_find_element_linear(const sl_lr_volume *lr, const double p[3]);
 
+/* Attaches the `auto` look-up structure (sl_lr_lookup.h: the texture where
+ * the knots allow, else the k-d forest) to a finished model, so
+ * sl_lr_find_element and sl_lr_eval(.., -1, ..) answer in O(log n) instead
+ * of a linear search. Loaders and generators call it; sl_lr_finish drops a
+ * stale one (refinement rebuilds the model). SL_ERR_NOMEM / LIMIT. */
+sl_status sl_lr_index(sl_lr_volume *lr, sl_err *err);
+
+/* The element containing p under the element rule: through the attached
+ * index when there is one, else sl_lr_find_element_linear; -1 outside. */
+long sl_lr_find_element(const sl_lr_volume *lr, const double p[3]);
+
 /* Value of the univariate B-spline on `order`+1 knots t, restricted to its
  * polynomial piece on [a, b] (a knot span inside its support), and its
  * first derivative, at x (any x: the piece is extended). 0, 0 when [a, b] is
@@ -109,7 +123,7 @@ void sl_lr_bspline_piece(const double *t, int order, double a, double b, double 
 /* Evaluates f at p (double, straight from the LR basis, no Bézier form):
  * value[dim]; gradient (may be NULL) gradient[c*3 + j] = d f_c / d x_j, the
  * Jacobian for vectors. element: the element to use, or -1 to look it up
- * with sl_lr_find_element_linear. SL_ERR_INVALID when p is outside. */
+ * with sl_lr_find_element. SL_ERR_INVALID when p is outside. */
 sl_status sl_lr_eval(const sl_lr_volume *lr, const double p[3], long element,
                      double *value, double *gradient, sl_err *err);
 

@@ -84,7 +84,7 @@ sl_status sl_probe_eval(const sl_dataset *ds, const double p[3], double *value, 
     if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
         return SL_OK;
     if (ds->kind == SL_DATASET_LR) {
-        long e = sl_lr_find_element_linear(ds->lr, p);
+        long e = sl_lr_find_element(ds->lr, p);
         if (e < 0)
             return SL_OK;
         sl_status st = sl_lr_eval(ds->lr, p, e, value, gradient, err);

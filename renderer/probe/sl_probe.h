@@ -9,7 +9,7 @@
  * (on a cell face the cell above, at the last voxel the cell below; 0 along a
  * one-voxel axis); taps of zero weight are not read (a NaN neighbour does not
  * reach a probe on a voxel). LR-spline volumes: sl_lr_eval on the element the
- * rule of lrspline/sl_lr.h picks (linear search). Line sets have no field.
+ * rule of lrspline/sl_lr.h picks (sl_lr_find_element: the model's look-up). Line sets have no field.
  * No GPU path here (tools/sightline_probe.c has the backend seam for one).
  * Any thread; the dataset is only read.
  */

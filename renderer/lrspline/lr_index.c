@@ -1,0 +1,37 @@
+/* lr_index.c — the CPU element look-up a model carries (sl_lr_index,
+ * sl_lr_find_element in sl_lr.h): the `auto` structure of sl_lr_lookup.h,
+ * built once per finished model and read-only afterwards, so any number of
+ * threads may query it. */
+#include <stdlib.h>
+
+#include "lr_index.h"
+#include "sl_lr_lookup.h"
+
+sl_status sl_lr_index(sl_lr_volume *lr, sl_err *err)
+{
+    sl_lr_drop_index(lr);
+    sl_lr_lookup *lk = calloc(1, sizeof *lk);
+    if (!lk)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the element look-up");
+    sl_status st = sl_lr_lookup_init(lk, lr, SL_LR_LOOKUP_AUTO, 0, err);
+    if (st != SL_OK) {
+        free(lk);
+        return st;
+    }
+    lr->index = lk;
+    return SL_OK;
+}
+
+void sl_lr_drop_index(sl_lr_volume *lr)
+{
+    if (lr->index) {
+        sl_lr_lookup_deinit(lr->index);
+        free(lr->index);
+        lr->index = NULL;
+    }
+}
+
+long sl_lr_find_element(const sl_lr_volume *lr, const double p[3])
+{
+    return lr->index ? sl_lr_lookup_find(lr->index, p) : sl_lr_find_element_linear(lr, p);
+}
