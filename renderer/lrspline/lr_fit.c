@@ -253,8 +253,7 @@ static sl_status solve(const samples *s, const design *a, sl_lr_volume *lr, int 
     for (size_t b = 0; b < nb; b++)
         gref += (scale[b] * ty[b]) * (scale[b] * ty[b]);
     double gamma = dot(g, g, nb);
-    int it = 0;
-    for (; it < iterations && gamma > cg_tol * cg_tol * gref && gamma > 0.0; it++) {
+    for (int it = 0; it < iterations && gamma > cg_tol * cg_tol * gref && gamma > 0.0; it++) {
         for (size_t b = 0; b < nb; b++)
             t[b] = scale[b] * p[b];
         mat_vec(a, lr, t, q);
@@ -279,8 +278,6 @@ static sl_status solve(const samples *s, const design *a, sl_lr_volume *lr, int 
     }
     for (size_t b = 0; b < nb; b++)
         lr->basis[b].coef[c] = x[b] + scale[b] * z[b];
-    if (getenv("SL_LRFIT_DEBUG"))
-        fprintf(stderr, "cgls component %d: %d iterations, residual ratio %.3g\n", c, it, sqrt(gamma / gref));
 done:
     free(x);
     free(scale);

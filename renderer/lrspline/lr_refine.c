@@ -449,7 +449,8 @@ static size_t merge_plane(sl_lr_meshrect *r, size_t n, int d)
 
 static size_t merge_rects(sl_lr_meshrect *r, size_t n)
 {
-    qsort(r, n, sizeof *r, rect_cmp);
+    if (n > 1)
+        qsort(r, n, sizeof *r, rect_cmp);
     size_t out = 0;
     for (size_t i = 0; i < n;) {
         size_t j = i + 1;
@@ -603,7 +604,8 @@ static sl_status refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n,
     }
 
     /* 2. Split the cut elements into the tensor grids of their cuts. */
-    qsort(w.cuts, w.cuts_n, sizeof *w.cuts, cut_cmp);
+    if (w.cuts_n > 1)
+        qsort(w.cuts, w.cuts_n, sizeof *w.cuts, cut_cmp);
     size_t ci = 0;
     for (size_t e = 0; e < ne; e++) {
         double vals[3][66];
