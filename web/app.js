@@ -69,6 +69,7 @@ window.sightline = {
   get progressStage() { return progress.stage; },
   get timings() { return progress.timings; },
   get recording() { return flight.lastJob; },
+  get playback() { return flight.lastPlayback; },
 };
 const flight = new FlightPanel($('flight'), {
   send: (msg) => conn.send(msg),
@@ -321,6 +322,9 @@ conn.addEventListener('message', (ev) => {
       break;
     case 'recording':
       flight.update(msg);
+      break;
+    case 'playback':
+      flight.playback(msg);
       break;
     case 'error':
       if (msg.code === 'load_failed') progress.hide();
