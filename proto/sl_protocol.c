@@ -42,6 +42,9 @@ static const msg_spec specs[] = {
     {"play_path", SL_MSG_PLAY_PATH, {"path", "loop", NULL}},
     {"play_stop", SL_MSG_PLAY_STOP, {NULL}},
     {"path_seek", SL_MSG_PATH_SEEK, {"path", "t", NULL}},
+    {"save_path", SL_MSG_SAVE_PATH, {"name", "path", NULL}},
+    {"list_paths", SL_MSG_LIST_PATHS, {NULL}},
+    {"load_path", SL_MSG_LOAD_PATH, {"name", NULL}},
 };
 
 static sl_status fail(sl_msg *msg, char *code, char *field, const char *c, const char *f,
@@ -204,8 +207,15 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg, char *code, ch
         break;
     case SL_MSG_SAVE_VIEW:
     case SL_MSG_LOAD_VIEW:
+    case SL_MSG_SAVE_PATH:
+    case SL_MSG_LOAD_PATH:
         if (get_string(root, "name", msg->name, sizeof msg->name) != 1 || !msg->name[0])
             return fail(msg, code, field, "bad_field", "name", err, "\"name\" must be a non-empty string of < %s bytes", "64");
+        if (msg->type == SL_MSG_SAVE_PATH) {
+            msg->path = cJSON_GetObjectItemCaseSensitive(root, "path");
+            if (!cJSON_IsObject(msg->path))
+                return fail(msg, code, field, "bad_field", "path", err, "save_path needs a \"path\" object (scene.md, Paths)%s", "");
+        }
         break;
     case SL_MSG_ACK:
         if (get_int(root, "frame", 0, 4294967295.0, &v) != 1)
@@ -492,6 +502,16 @@ char *sl_msg_playback_text(const char *state, double t, double duration, int fra
     cJSON_AddBoolToObject(o, "loop", loop);
     if (reason)
         cJSON_AddStringToObject(o, "reason", reason);
+    return print_and_free(o);
+}
+
+char *sl_msg_named_text(const char *type, const char *name, cJSON *path)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", type);
+    cJSON_AddStringToObject(o, "name", name);
+    if (path)
+        cJSON_AddItemToObject(o, "path", path);
     return print_and_free(o);
 }
 

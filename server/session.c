@@ -650,6 +650,51 @@ static void on_play(sl_server *srv, sl_client *c, const sl_msg *m)
         send_error(srv, c, st == SL_ERR_NOMEM ? "internal" : "bad_field", err.message, "path");
 }
 
+/* save_path (controller): the path checked against the session's technique, stored by name. */
+static void on_save_path(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    sl_err err = {0};
+    const sl_technique *t = sl_technique_find(s->state.technique);
+    sl_scene_path *p = NULL;
+    if (!t || sl_scene_path_parse(m->path, t, &p, &err) != SL_OK) {
+        send_error(srv, c, "bad_field", t ? err.message : "the session's technique is not in this build", "path");
+        return;
+    }
+    char *text = cJSON_PrintUnformatted(m->path);
+    if (text && strlen(text) > SL_CATALOG_MAX_PATH_BYTES) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "path: %zu bytes of JSON; a saved path holds at most %d", strlen(text),
+                 SL_CATALOG_MAX_PATH_BYTES);
+        send_error(srv, c, "limit", msg, "path");
+        free(text);
+        sl_scene_path_destroy(p);
+        return;
+    }
+    sl_status st = text ? sl_catalog_save_path(srv->db, m->name, t->name, text, p->key_count,
+                                               p->keys[p->key_count - 1].t, &err)
+                        : sl_err_set(&err, SL_ERR_NOMEM, "out of memory writing the path");
+    free(text);
+    sl_scene_path_destroy(p);
+    if (st != SL_OK)
+        send_error(srv, c, st == SL_ERR_LIMIT ? "limit" : "internal", err.message, "name");
+    else
+        sl_client_queue_text(c, sl_msg_named_text("path_saved", m->name, NULL));
+}
+
+/* load_path (any client): the stored path, to the requester only. */
+static void on_load_path(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_err err = {0};
+    cJSON *p = NULL;
+    if (sl_catalog_load_path(srv->db, m->name, &p, &err) != SL_OK || !p) {
+        send_error(srv, c, p ? "internal" : "not_found", p ? err.message : "no saved path with that name", "name");
+        cJSON_Delete(p);
+        return;
+    }
+    sl_client_queue_text(c, sl_msg_named_text("path", m->name, p));
+}
+
 static void on_control(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
@@ -823,6 +868,16 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     case SL_MSG_RECORD_CANCEL:
         if (require_control(srv, c, "record_cancel"))
             on_record_cancel(srv, c);
+        break;
+    case SL_MSG_SAVE_PATH:
+        if (require_control(srv, c, "save_path"))
+            on_save_path(srv, c, &m);
+        break;
+    case SL_MSG_LIST_PATHS:
+        sl_client_queue_text(c, sl_msg_list_text("paths", "paths", sl_catalog_list_paths_json(srv->db)));
+        break;
+    case SL_MSG_LOAD_PATH:
+        on_load_path(srv, c, &m);
         break;
     case SL_MSG_PLAY_PATH:
     case SL_MSG_PLAY_STOP:

@@ -69,6 +69,8 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
+#define SL_CATALOG_MAX_PATHS 256       /* saved paths; save_path of a new name fails above */
+#define SL_CATALOG_MAX_PATH_BYTES 32768 /* JSON text of one saved path */
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
@@ -523,6 +525,16 @@ sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *datase
 /* *view receives {name, dataset, technique, params, camera} or NULL when absent. */
 sl_status sl_catalog_load_view(sqlite3 *db, const char *name, cJSON **view, sl_err *err);
 cJSON *sl_catalog_list_views_json(sqlite3 *db);
+/* Stores or replaces a named path (path_json already checked by the
+ * caller, with its key count and last key time); SL_ERR_LIMIT when the
+ * text is over SL_CATALOG_MAX_PATH_BYTES or, for a new name,
+ * SL_CATALOG_MAX_PATHS paths exist. */
+sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *technique, const char *path_json,
+                               int keys, double duration, sl_err *err);
+/* *path receives the stored path object, or NULL when no path has that name. */
+sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err);
+/* [{name, technique, keys, duration, created}] by name. */
+cJSON *sl_catalog_list_paths_json(sqlite3 *db);
 sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *state_json, sl_err *err);
 sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err);
 /* Sessions live in memory; rows left by a previous run are removed at start. */
