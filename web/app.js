@@ -288,6 +288,7 @@ conn.addEventListener('message', (ev) => {
       setBanner('');
       progress.hide();
       conn.send({ type: 'list_views' });
+      conn.send({ type: 'list_paths' });
       break;
     case 'state':
       applyState(msg.patch || {});
@@ -325,6 +326,15 @@ conn.addEventListener('message', (ev) => {
       break;
     case 'playback':
       flight.playback(msg);
+      break;
+    case 'paths':
+      flight.listed(msg.paths || []);
+      break;
+    case 'path_saved':
+      conn.send({ type: 'list_paths' });
+      break;
+    case 'path':
+      flight.loaded(msg);
       break;
     case 'error':
       if (msg.code === 'load_failed') progress.hide();

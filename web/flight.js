@@ -9,7 +9,9 @@
 // the path stays in ascending time. The timeline spans [0, last key's t]:
 // dragging it sends `path_seek` (throttled) and the server sets the session's
 // camera to the path at that t; Play/Stop send `play_path` / `play_stop`, and
-// every client's timeline follows the `playback` messages. Interpolation
+// every client's timeline follows the `playback` messages. Paths are saved in
+// the server's catalog by name (`save_path`; `list_paths`, `load_path` bring
+// one back as keyframes, its fps too). Interpolation
 // happens on the server only (renderer/core/camera_path.c), so there is no
 // second copy of it here. Sends nothing unless a control is used.
 
@@ -25,6 +27,7 @@ export class FlightPanel {
     this.camera = camera;
     this.keys = [];             // {t, camera}
     this.step = 2;              // seconds between a new key and the last
+    this.interpolation = 'smooth'; // a loaded path's, else smooth
     this.list = root.querySelector('.keys');
     this.status = root.querySelector('.record-status');
     this.link = root.querySelector('.record-link');
@@ -42,6 +45,16 @@ export class FlightPanel {
     this.timeline.addEventListener('change', () => { this.seekAt = Number(this.timeline.value); seek(true); });
     root.querySelector('.play').addEventListener('click', () => this.play());
     root.querySelector('.stop').addEventListener('click', () => this.send({ type: 'play_stop' }));
+    root.querySelector('.save-path').addEventListener('click', () => {
+      const name = root.querySelector('.path-name').value.trim();
+      const path = this.path();
+      if (!name || !path) { this.playStatus.textContent = 'a path needs a name and two keyframes'; return; }
+      this.send({ type: 'save_path', name, path });
+    });
+    root.querySelector('.load-path').addEventListener('click', () => {
+      const name = root.querySelector('.paths').value;
+      if (name) this.send({ type: 'load_path', name });
+    });
     root.querySelector('.add-key').addEventListener('click', () => this.addKey());
     root.querySelector('.clear-keys').addEventListener('click', () => { this.keys = []; this.render(); });
     root.querySelector('.record').addEventListener('click', () => this.record());
@@ -62,7 +75,8 @@ export class FlightPanel {
     const keys = [...this.keys].sort((a, b) => a.t - b.t);
     if (keys.length < 2) return null;
     const fps = Number(this.root.querySelector('.fps').value) || 24;
-    return { fps, interpolation: 'smooth', keyframes: keys.map((k) => ({ t: k.t, camera: k.camera })) };
+    return { fps, interpolation: this.interpolation,
+      keyframes: keys.map((k) => ({ t: k.t, camera: k.camera, ...(k.params ? { params: k.params } : {}) })) };
   }
 
   play() {
@@ -89,11 +103,27 @@ export class FlightPanel {
       : `stopped (${msg.reason})`;
   }
 
+  // A `paths` reply: the catalog's saved paths.
+  listed(paths) {
+    this.root.querySelector('.paths').replaceChildren(
+      ...paths.map((p) => new Option(`${p.name} — ${p.keys} keys, ${p.duration} s`, p.name)));
+  }
+
+  // A `path` reply: the saved path becomes the keyframes (times, cameras; keyed params are kept).
+  loaded(msg) {
+    this.keys = msg.path.keyframes.map((k) => ({ t: k.t, camera: k.camera, ...(k.params ? { params: k.params } : {}) }));
+    this.root.querySelector('.fps').value = String(msg.path.fps);
+    this.interpolation = msg.path.interpolation || 'smooth';
+    this.playStatus.textContent = `loaded path ${msg.name}`;
+    this.render();
+  }
+
   // Swaps the cameras of keys i and j; the times stay with the positions.
   move(i, j) {
     if (j < 0 || j >= this.keys.length) return;
     const a = this.keys[i], b = this.keys[j];
     [a.camera, b.camera] = [b.camera, a.camera];
+    [a.params, b.params] = [b.params, a.params];
     this.render();
   }
 

@@ -329,6 +329,18 @@ async function driveControls(page, obs, sess, saved) {
   check(between && Math.abs(az0 - az1) > 1, `timeline drag: azimuth ${azMid} between the keys' ${az0} and ${az1}`);
   await settled(page);
 
+  // The keys saved as a named path in the catalog, cleared, and loaded back.
+  await page.fill('#flight .path-name', 'browser flight');
+  await page.click('#flight .save-path');
+  await page.waitForFunction(() => [...document.querySelectorAll('#flight .paths option')].some((o) => o.value === 'browser flight'),
+    null, { timeout: 15000 });
+  await page.click('#flight .clear-keys');
+  await page.selectOption('#flight .paths', 'browser flight');
+  await page.click('#flight .load-path');
+  await page.waitForFunction(() => document.querySelectorAll('#flight .keys .key').length === 2, null, { timeout: 15000 })
+    .then(() => {}, () => {});
+  check((await page.$$eval('#flight .keys .key', (ks) => ks.length)) === 2, 'the saved path loads back as two keyframes');
+
   // Technique picker: the server switches, the controls follow the new schema.
   const tech = 'tubes';
   await page.selectOption('#technique', tech);
