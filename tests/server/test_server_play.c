@@ -151,6 +151,8 @@ int main(void)
         cJSON_Delete(j);
         drain(&a);
     }
+    fprintf(stderr, "playback: B heard %d playing messages and received %d frames showing %d cameras\n", playing,
+            frames, distinct);
     SL_CHECK_MSG(playing >= 1, "B heard `playback` playing (%d times)", playing);
     SL_CHECK_MSG(stopped && strcmp(stop_reason, "end") == 0, "B heard playback stopped at the end (\"%s\")",
                  stop_reason);
