@@ -26,7 +26,11 @@
 // the new frame), "load view" (the saved view's dataset, technique, params
 // and camera come back), and control hand-over to the second page (request,
 // grant, the new controller's change reaches the server, the old one's
-// controls are disabled). Screenshots go to <source>/build/ (CI artifact).
+// controls are disabled), the Flight panel (two keys recorded into a video
+// fetched once; Play: `playback` playing then stopped at the end, the frame
+// id advancing and the camera on the last key; a drag of the timeline puts
+// the server's camera between the keys; the keys saved by name, cleared and
+// loaded back). Screenshots go to <source>/build/ (CI artifact).
 // Prints "N passed, N failed".
 'use strict';
 
