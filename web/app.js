@@ -103,6 +103,7 @@ function refreshRole() {
   $('technique').disabled = !ctl;
   $('load-view').disabled = !ctl;
   $('save-view').disabled = !ctl;
+  flight.setEnabled(ctl);
 }
 
 function techniqueByName(name) {

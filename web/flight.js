@@ -103,6 +103,14 @@ export class FlightPanel {
       : `stopped (${msg.reason})`;
   }
 
+  // Viewers watch a playing path (their timeline follows it) but cannot play,
+  // stop, seek, record or save one: the server would refuse it.
+  setEnabled(on) {
+    for (const sel of ['.play', '.stop', '.timeline', '.record', '.record-cancel', '.save-path']) {
+      this.root.querySelector(sel).disabled = !on;
+    }
+  }
+
   // A `paths` reply: the catalog's saved paths.
   listed(paths) {
     this.root.querySelector('.paths').replaceChildren(
