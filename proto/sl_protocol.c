@@ -39,6 +39,12 @@ static const msg_spec specs[] = {
     {"ping", SL_MSG_PING, {"seq", NULL}},
     {"record", SL_MSG_RECORD, {"path", "format", "crf", NULL}},
     {"record_cancel", SL_MSG_RECORD_CANCEL, {NULL}},
+    {"play_path", SL_MSG_PLAY_PATH, {"path", "loop", NULL}},
+    {"play_stop", SL_MSG_PLAY_STOP, {NULL}},
+    {"path_seek", SL_MSG_PATH_SEEK, {"path", "t", NULL}},
+    {"save_path", SL_MSG_SAVE_PATH, {"name", "path", NULL}},
+    {"list_paths", SL_MSG_LIST_PATHS, {NULL}},
+    {"load_path", SL_MSG_LOAD_PATH, {"name", NULL}},
 };
 
 static sl_status fail(sl_msg *msg, char *code, char *field, const char *c, const char *f,
@@ -201,8 +207,15 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg, char *code, ch
         break;
     case SL_MSG_SAVE_VIEW:
     case SL_MSG_LOAD_VIEW:
+    case SL_MSG_SAVE_PATH:
+    case SL_MSG_LOAD_PATH:
         if (get_string(root, "name", msg->name, sizeof msg->name) != 1 || !msg->name[0])
             return fail(msg, code, field, "bad_field", "name", err, "\"name\" must be a non-empty string of < %s bytes", "64");
+        if (msg->type == SL_MSG_SAVE_PATH) {
+            msg->path = cJSON_GetObjectItemCaseSensitive(root, "path");
+            if (!cJSON_IsObject(msg->path))
+                return fail(msg, code, field, "bad_field", "path", err, "save_path needs a \"path\" object (scene.md, Paths)%s", "");
+        }
         break;
     case SL_MSG_ACK:
         if (get_int(root, "frame", 0, 4294967295.0, &v) != 1)
@@ -241,6 +254,24 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg, char *code, ch
             return fail(msg, code, field, "bad_field", "crf", err, "\"crf\" must be an integer in [0, 63]%s", "");
         msg->crf = r ? (int)v : -1;
         break;
+    case SL_MSG_PLAY_PATH:
+    case SL_MSG_PATH_SEEK: {
+        const char *what = msg->type == SL_MSG_PLAY_PATH ? "play_path" : "path_seek";
+        msg->path = cJSON_GetObjectItemCaseSensitive(root, "path");
+        if (!cJSON_IsObject(msg->path))
+            return fail(msg, code, field, "bad_field", "path", err, "%s needs a \"path\" object (scene.md, Paths)", what);
+        const cJSON *loop = cJSON_GetObjectItemCaseSensitive(root, "loop");
+        if (loop && !cJSON_IsBool(loop))
+            return fail(msg, code, field, "bad_field", "loop", err, "\"loop\" must be true or false%s", "");
+        msg->loop = cJSON_IsTrue(loop);
+        if (msg->type == SL_MSG_PATH_SEEK) {
+            const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "t");
+            if (!cJSON_IsNumber(t) || !isfinite(t->valuedouble) || t->valuedouble < 0 || t->valuedouble > 1e6)
+                return fail(msg, code, field, "bad_field", "t", err, "path_seek needs \"t\", seconds in [0, %s]", "1e6");
+            msg->t = t->valuedouble;
+        }
+        break;
+    }
     case SL_MSG_PING:
         if (get_int(root, "seq", 0, 9007199254740991.0, &v) < 0)
             return fail(msg, code, field, "bad_field", "seq", err, "\"seq\" must be an integer%s", "");
@@ -455,6 +486,32 @@ char *sl_msg_view_saved_text(const char *name)
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "type", "view_saved");
     cJSON_AddStringToObject(o, "name", name);
+    return print_and_free(o);
+}
+
+char *sl_msg_playback_text(const char *state, double t, double duration, int frame, int frames, int loop,
+                           const char *reason)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "playback");
+    cJSON_AddStringToObject(o, "state", state);
+    cJSON_AddNumberToObject(o, "t", t);
+    cJSON_AddNumberToObject(o, "duration", duration);
+    cJSON_AddNumberToObject(o, "frame", frame);
+    cJSON_AddNumberToObject(o, "frames", frames);
+    cJSON_AddBoolToObject(o, "loop", loop);
+    if (reason)
+        cJSON_AddStringToObject(o, "reason", reason);
+    return print_and_free(o);
+}
+
+char *sl_msg_named_text(const char *type, const char *name, cJSON *path)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", type);
+    cJSON_AddStringToObject(o, "name", name);
+    if (path)
+        cJSON_AddItemToObject(o, "path", path);
     return print_and_free(o);
 }
 

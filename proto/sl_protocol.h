@@ -48,6 +48,12 @@ typedef enum sl_msg_type {
     SL_MSG_PING,
     SL_MSG_RECORD,
     SL_MSG_RECORD_CANCEL,
+    SL_MSG_PLAY_PATH,
+    SL_MSG_PLAY_STOP,
+    SL_MSG_PATH_SEEK,
+    SL_MSG_SAVE_PATH,
+    SL_MSG_LIST_PATHS,
+    SL_MSG_LOAD_PATH,
 } sl_msg_type;
 
 typedef enum sl_camera_phase {
@@ -79,11 +85,13 @@ typedef struct sl_msg {
     const cJSON *background;          /* set (optional): [r,g,b,a], borrowed */
     char dataset[SL_PROTO_NAME_MAX];  /* scene: "" = keep */
     char technique[SL_PROTO_NAME_MAX];/* scene: "" = keep */
-    char name[SL_PROTO_ID_MAX];       /* save_view, load_view */
+    char name[SL_PROTO_ID_MAX];       /* save_view, load_view, save_path, load_path */
     uint32_t frame_id;                /* ack */
     sl_control_action action;         /* control */
     int client;                       /* control grant: target client id */
-    const cJSON *path;                /* record: the path object (scene.md "Paths"), borrowed */
+    const cJSON *path;                /* record, play_path, path_seek, save_path: the path object (scene.md "Paths"), borrowed */
+    int loop;                         /* play_path: 1 = start again at t = 0 after the last key */
+    double t;                         /* path_seek: seconds, finite, >= 0 */
     char format[8];                   /* record: "mp4" or "webm" */
     int crf;                          /* record: -1 = the codec's default */
 } sl_msg;
@@ -187,8 +195,14 @@ char *sl_msg_welcome_text(const sl_msg_welcome *w);
 /* {"type":type,key:list (consumed)}: "datasets"/"datasets", "views"/"views". */
 char *sl_msg_list_text(const char *type, const char *key, cJSON *list);
 char *sl_msg_view_saved_text(const char *name);
+/* {"type":type,"name":name} plus "path": path (consumed, may be NULL): path_saved, path. */
+char *sl_msg_named_text(const char *type, const char *name, cJSON *path);
 char *sl_msg_control_request_text(int client);
 char *sl_msg_pong_text(long long seq);
+/* {"type":"playback","state":"playing"|"stopped","t","duration","frame","frames","loop"} plus
+ * "reason" (stopped only; NULL leaves it out): the session's live path playback. */
+char *sl_msg_playback_text(const char *state, double t, double duration, int frame, int frames, int loop,
+                           const char *reason);
 
 /* Long work on a session's scene, in the order it happens (PROTOCOL.md,
  * "Progress"): loading the dataset, preparing the technique, rendering the

@@ -1,4 +1,4 @@
-/* catalog.c — the SQLite catalog: datasets, saved views, sessions.
+/* catalog.c — the SQLite catalog: datasets, saved views, named camera paths, sessions.
  *
  * One database file in WAL mode (readers never block the writer). Every
  * statement is prepared with bound parameters; no SQL is ever built from
@@ -10,7 +10,11 @@
  * Removal sticks: `remove` leaves a row in `removed`, and the automatic
  * registration at start (built-ins, <data-dir>/samples) skips those names;
  * only an explicit add, add-generator, scan or add-builtins brings one back.
- * Saved views are capped at SL_CATALOG_MAX_VIEWS rows.
+ * Saved views are capped at SL_CATALOG_MAX_VIEWS rows, named paths (scene.md
+ * "Paths", stored as the JSON text the server checked) at
+ * SL_CATALOG_MAX_PATHS rows of at most SL_CATALOG_MAX_PATH_BYTES each.
+ * Schema 3 added `paths`; an older file gets the table at open (CREATE IF
+ * NOT EXISTS) and its schema_version raised.
  * Used by the lws service thread (server) or the `catalog` CLI, never both
  * on one connection, never from the render thread.
  */
@@ -47,8 +51,13 @@ static const char *schema_sql =
     "CREATE TABLE IF NOT EXISTS removed("
     " name TEXT PRIMARY KEY,"
     " removed TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
+    "CREATE TABLE IF NOT EXISTS paths("
+    " id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, technique TEXT NOT NULL, path TEXT NOT NULL,"
+    " keys INTEGER NOT NULL, duration REAL NOT NULL,"
+    " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
     "CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '2');";
+    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '3');"
+    "UPDATE meta SET value = '3' WHERE key = 'schema_version' AND CAST(value AS INTEGER) < 3;";
 
 static sl_status db_fail(sqlite3 *db, sl_err *err, const char *what)
 {
@@ -580,6 +589,77 @@ cJSON *sl_catalog_list_views_json(sqlite3 *db)
         cJSON_AddStringToObject(o, "dataset", (const char *)sqlite3_column_text(q, 1));
         cJSON_AddStringToObject(o, "technique", (const char *)sqlite3_column_text(q, 2));
         cJSON_AddStringToObject(o, "created", (const char *)sqlite3_column_text(q, 3));
+        cJSON_AddItemToArray(arr, o);
+    }
+    sqlite3_finalize(q);
+    return arr;
+}
+
+sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *technique, const char *path_json,
+                               int keys, double duration, sl_err *err)
+{
+    size_t bytes = strlen(path_json);
+    if (bytes > SL_CATALOG_MAX_PATH_BYTES)
+        return sl_err_set(err, SL_ERR_LIMIT, "path: %zu bytes of JSON; a saved path holds at most %d", bytes,
+                          SL_CATALOG_MAX_PATH_BYTES);
+    sqlite3_stmt *q = NULL;
+    long long count = 0;
+    int exists = 0;
+    if (sqlite3_prepare_v2(db, "SELECT COUNT(*), SUM(name = ?1) FROM paths", -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare count paths");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(q) == SQLITE_ROW) {
+        count = sqlite3_column_int64(q, 0);
+        exists = sqlite3_column_int64(q, 1) > 0;
+    }
+    sqlite3_finalize(q);
+    q = NULL;
+    if (!exists && count >= SL_CATALOG_MAX_PATHS)
+        return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved paths (the limit); reuse a name",
+                          SL_CATALOG_MAX_PATHS);
+    if (sqlite3_prepare_v2(db,
+                           "INSERT INTO paths(name, technique, path, keys, duration) VALUES(?1, ?2, ?3, ?4, ?5)"
+                           " ON CONFLICT(name) DO UPDATE SET technique = excluded.technique, path = excluded.path,"
+                           " keys = excluded.keys, duration = excluded.duration",
+                           -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare save_path");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(q, 2, technique, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(q, 3, path_json, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int(q, 4, keys);
+    sqlite3_bind_double(q, 5, duration);
+    int rc = sqlite3_step(q);
+    sqlite3_finalize(q);
+    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "save_path");
+}
+
+sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err)
+{
+    *path = NULL;
+    sqlite3_stmt *q = NULL;
+    if (sqlite3_prepare_v2(db, "SELECT path FROM paths WHERE name = ?1", -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare load_path");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(q) == SQLITE_ROW)
+        *path = column_json(q, 0);
+    sqlite3_finalize(q);
+    return SL_OK;
+}
+
+cJSON *sl_catalog_list_paths_json(sqlite3 *db)
+{
+    cJSON *arr = cJSON_CreateArray();
+    sqlite3_stmt *q = NULL;
+    if (sqlite3_prepare_v2(db, "SELECT name, technique, keys, duration, created FROM paths ORDER BY name", -1, &q,
+                           NULL) != SQLITE_OK)
+        return arr;
+    while (sqlite3_step(q) == SQLITE_ROW) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
+        cJSON_AddStringToObject(o, "technique", (const char *)sqlite3_column_text(q, 1));
+        cJSON_AddNumberToObject(o, "keys", sqlite3_column_int(q, 2));
+        cJSON_AddNumberToObject(o, "duration", sqlite3_column_double(q, 3));
+        cJSON_AddStringToObject(o, "created", (const char *)sqlite3_column_text(q, 4));
         cJSON_AddItemToArray(arr, o);
     }
     sqlite3_finalize(q);

@@ -33,6 +33,7 @@
 #include "core/sl_technique.h"
 #include "sl_params_json.h"
 #include "sl_scene.h"
+#include "sl_scene_path.h"
 
 void sl_random_hex(char *out, int bytes)
 {
@@ -184,6 +185,8 @@ void sl_session_free(sl_session *s)
         free(s->progress_text[i]);
     sl_record_free(s->record);
     free(s->record_text);
+    sl_scene_path_destroy(s->play);
+    free(s->play_text);
     cJSON_Delete(s->bounds);
     free(s);
 }
@@ -297,6 +300,7 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     /* The newest recording state is news while its job runs or waits to be fetched. */
     c->record_seq = s->record && (!s->record->finished || s->record->ok) ? s->record_seq - 1 : s->record_seq;
     pthread_mutex_unlock(&srv->lock);
+    c->play_seq = s->play ? s->play_seq - 1 : s->play_seq; /* a path playing is news; a stopped one is not */
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
     sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
                         .is_controller = s->controller == c->id, .state = state_json(s),
@@ -572,7 +576,9 @@ static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
         cJSON_ArrayForEach(v, m->background)
             next.background[i++] = (float)v->valuedouble;
     }
-    next.phase = SL_PHASE_NONE;
+    next.phase = s->play ? s->state.phase : SL_PHASE_NONE; /* a playing path keeps its interactive frames */
+    if (s->play && m->params)
+        s->play_base = next.params; /* keyed parameters still follow the path over the new values */
     pthread_mutex_lock(&srv->lock);
     s->state = next;
     state_changed_locked(srv, s);
@@ -604,6 +610,89 @@ static void on_camera(sl_server *srv, sl_client *c, const sl_msg *m)
     cJSON_AddItemToObject(p, "camera", sl_camera_to_json(&cam));
     cJSON_AddNumberToObject(p, "camera_seq", (double)m->seq);
     broadcast_patch(s, p);
+}
+
+void sl_session_set_view(sl_server *srv, sl_session *s, const sl_camera_spec *camera, const sl_params *params,
+                         sl_camera_phase phase)
+{
+    pthread_mutex_lock(&srv->lock);
+    s->state.camera = *camera;
+    if (params)
+        s->state.params = *params;
+    s->state.phase = phase;
+    s->state.camera_ms = sl_clock_ms();
+    state_changed_locked(srv, s);
+    pthread_mutex_unlock(&srv->lock);
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddItemToObject(p, "camera", sl_camera_to_json(camera));
+    if (params)
+        cJSON_AddItemToObject(p, "params", sl_params_to_json(params));
+    broadcast_patch(s, p);
+}
+
+/* play_path, play_stop, path_seek (controller): playback.c does the work. */
+static void on_play(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    sl_err err = {0};
+    sl_status st = SL_OK;
+    if (m->type == SL_MSG_PLAY_STOP) {
+        if (!s->play)
+            send_error(srv, c, "bad_field", "no path is playing in this session", "type");
+        sl_play_stop(srv, s, "play_stop");
+        return;
+    }
+    if (m->type == SL_MSG_PLAY_PATH)
+        st = sl_play_start(srv, s, m->path, m->loop, &err);
+    else
+        st = sl_play_seek(srv, s, m->path, m->t, &err);
+    if (st != SL_OK)
+        send_error(srv, c, st == SL_ERR_NOMEM ? "internal" : "bad_field", err.message, "path");
+}
+
+/* save_path (controller): the path checked against the session's technique, stored by name. */
+static void on_save_path(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_session *s = c->session;
+    sl_err err = {0};
+    const sl_technique *t = sl_technique_find(s->state.technique);
+    sl_scene_path *p = NULL;
+    if (!t || sl_scene_path_parse(m->path, t, &p, &err) != SL_OK) {
+        send_error(srv, c, "bad_field", t ? err.message : "the session's technique is not in this build", "path");
+        return;
+    }
+    char *text = cJSON_PrintUnformatted(m->path);
+    if (text && strlen(text) > SL_CATALOG_MAX_PATH_BYTES) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "path: %zu bytes of JSON; a saved path holds at most %d", strlen(text),
+                 SL_CATALOG_MAX_PATH_BYTES);
+        send_error(srv, c, "limit", msg, "path");
+        free(text);
+        sl_scene_path_destroy(p);
+        return;
+    }
+    sl_status st = text ? sl_catalog_save_path(srv->db, m->name, t->name, text, p->key_count,
+                                               p->keys[p->key_count - 1].t, &err)
+                        : sl_err_set(&err, SL_ERR_NOMEM, "out of memory writing the path");
+    free(text);
+    sl_scene_path_destroy(p);
+    if (st != SL_OK)
+        send_error(srv, c, st == SL_ERR_LIMIT ? "limit" : "internal", err.message, "name");
+    else
+        sl_client_queue_text(c, sl_msg_named_text("path_saved", m->name, NULL));
+}
+
+/* load_path (any client): the stored path, to the requester only. */
+static void on_load_path(sl_server *srv, sl_client *c, const sl_msg *m)
+{
+    sl_err err = {0};
+    cJSON *p = NULL;
+    if (sl_catalog_load_path(srv->db, m->name, &p, &err) != SL_OK || !p) {
+        send_error(srv, c, p ? "internal" : "not_found", p ? err.message : "no saved path with that name", "name");
+        cJSON_Delete(p);
+        return;
+    }
+    sl_client_queue_text(c, sl_msg_named_text("path", m->name, p));
 }
 
 static void on_control(sl_server *srv, sl_client *c, const sl_msg *m)
@@ -672,16 +761,20 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
         on_hello(srv, c, &m);
         break;
     case SL_MSG_CAMERA:
-        if (require_control(srv, c, "camera"))
+        if (require_control(srv, c, "camera")) {
+            sl_play_stop(srv, s, "camera"); /* the controller takes the camera back */
             on_camera(srv, c, &m);
+        }
         break;
     case SL_MSG_SET:
         if (require_control(srv, c, "set"))
             on_set(srv, c, &m);
         break;
     case SL_MSG_SCENE:
-        if (require_control(srv, c, "scene"))
+        if (require_control(srv, c, "scene")) {
+            sl_play_stop(srv, s, "scene"); /* the path was checked against the technique it replaces */
             apply_scene(srv, c, m.dataset, m.technique, m.params, m.camera);
+        }
         break;
     case SL_MSG_RESIZE:
         if (require_control(srv, c, "resize")) {
@@ -726,6 +819,7 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     case SL_MSG_LOAD_VIEW: {
         if (!require_control(srv, c, "load_view"))
             break;
+        sl_play_stop(srv, s, "scene");
         cJSON *v = NULL;
         if (sl_catalog_load_view(srv->db, m.name, &v, &err) != SL_OK || !v) {
             send_error(srv, c, "not_found", v ? err.message : "no saved view with that name", "name");
@@ -774,6 +868,22 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     case SL_MSG_RECORD_CANCEL:
         if (require_control(srv, c, "record_cancel"))
             on_record_cancel(srv, c);
+        break;
+    case SL_MSG_SAVE_PATH:
+        if (require_control(srv, c, "save_path"))
+            on_save_path(srv, c, &m);
+        break;
+    case SL_MSG_LIST_PATHS:
+        sl_client_queue_text(c, sl_msg_list_text("paths", "paths", sl_catalog_list_paths_json(srv->db)));
+        break;
+    case SL_MSG_LOAD_PATH:
+        on_load_path(srv, c, &m);
+        break;
+    case SL_MSG_PLAY_PATH:
+    case SL_MSG_PLAY_STOP:
+    case SL_MSG_PATH_SEEK:
+        if (require_control(srv, c, sl_msg_type_name(m.type)))
+            on_play(srv, c, &m);
         break;
     default:
         break;
@@ -1026,6 +1136,11 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     pthread_mutex_unlock(&srv->lock);
     if (recording)
         return write_text_now(c, recording);
+    if (c->play_seq != s->play_seq) {
+        c->play_seq = s->play_seq;
+        if (s->play_text)
+            return write_text_now(c, strdup(s->play_text));
+    }
     if (c->snapshot) {
         sl_frame_buf *f = c->snapshot;
         c->snapshot = NULL;

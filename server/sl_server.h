@@ -11,6 +11,8 @@
  *   dataset_cache.c  datasets by source: cached, shared, loaded on its own
  *              loader threads (any caller; its own lock)
  *   encoder.c  frame buffers (refcounted) and JPEG/PNG encoding (render thread)
+ *   playback.c live playback of a camera path in a session, seen by all its
+ *              clients, and path_seek (service thread)
  *   record.c   recording jobs: a camera path rendered into a video in the
  *              background of a session, its status texts and its one-time
  *              download (service thread; the frames render in render.c)
@@ -67,6 +69,8 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
+#define SL_CATALOG_MAX_PATHS 256       /* saved paths; save_path of a new name fails above */
+#define SL_CATALOG_MAX_PATH_BYTES 32768 /* JSON text of one saved path */
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
@@ -252,6 +256,7 @@ struct sl_client {                  /* [service] */
     int wants_control;              /* asked for control; the controller has not been told yet */
     uint32_t progress_seq;          /* newest session progress text sent (set at attach) */
     uint32_t record_seq;            /* session record_seq whose text was sent (set at attach) */
+    uint32_t play_seq;              /* session play_seq whose text was sent (set at attach) */
     int close_after_send;
     sl_client *next;                /* in session->clients */
 };
@@ -300,6 +305,13 @@ struct sl_session {
     int controller;                          /* client id, 0 = nobody */
     double empty_since_ms;
     uint32_t dispatched_frame;               /* newest frame id dispatched to clients */
+    sl_scene_path *play;                     /* the path playing live (playback.c), owned, or NULL */
+    double play_t0_ms;                       /* when t = 0 of the path was (moves on at each loop) */
+    int play_loop;                           /* 1: start again after the last key */
+    int play_frame;                          /* the path frame shown last, -1 none */
+    sl_params play_base;                     /* the parameters a keyed parameter is applied over */
+    char *play_text;                         /* newest `playback` message (newest wins), owned */
+    uint32_t play_seq;                       /* bumped with every new play_text */
     cJSON *bounds;                           /* [[x,y,z],[x,y,z]] of the loaded dataset, or NULL */
     /* [render] */
     sl_prepared *prepared;                   /* the scene it renders through (a reference), or NULL */
@@ -375,6 +387,31 @@ void sl_random_hex(char *out, int bytes);
 int sl_client_queue_text(sl_client *c, char *text);
 /* Called from ws.c on writable: sends one message. Returns -1 to close. */
 int sl_client_write_next(sl_server *srv, sl_client *c);
+
+/* The session's camera (and parameters, when params is not NULL) set by
+ * the server itself (path playback and seek): the state changes as for a
+ * camera message with `phase` (camera_seq kept), and every client gets the
+ * patch. */
+void sl_session_set_view(sl_server *srv, sl_session *s, const sl_camera_spec *camera, const sl_params *params,
+                         sl_camera_phase phase);
+
+/* playback.c (service thread) */
+/* Starts playing path (scene.md "Paths", checked against the session's
+ * technique; replaces a path playing) from t = 0: the session's camera and
+ * keyed parameters follow it in real time, one state change per path
+ * frame (k / fps) that is due, so the render thread's newest-wins state
+ * drops frames when rendering is slower. SL_ERR_INVALID naming the field. */
+sl_status sl_play_start(sl_server *srv, sl_session *s, const cJSON *path, int loop, sl_err *err);
+/* Stops a playing path (nothing when none) and tells every client why
+ * (reason: "play_stop", "camera", "scene", "seek"). The camera stays where it was. */
+void sl_play_stop(sl_server *srv, sl_session *s, const char *reason);
+/* Sets the session's camera and keyed parameters to path's at time t (a
+ * still frame), stopping playback first. SL_ERR_INVALID naming the field. */
+sl_status sl_play_seek(sl_server *srv, sl_session *s, const cJSON *path, double t, sl_err *err);
+/* Steps every playing session; returns ms until the next step is due, -1 when nothing plays. */
+double sl_play_tick(sl_server *srv);
+/* ws.c: runs sl_play_tick in ms from now (replacing an earlier schedule). */
+void sl_ws_play_schedule(sl_server *srv, double ms);
 
 /* dataset_cache.c (any thread; its own lock): datasets by source, loaded on
  * SL_DATASET_LOADERS loader threads, the last SL_DATASET_CACHE_SLOTS kept. */
@@ -488,6 +525,16 @@ sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *datase
 /* *view receives {name, dataset, technique, params, camera} or NULL when absent. */
 sl_status sl_catalog_load_view(sqlite3 *db, const char *name, cJSON **view, sl_err *err);
 cJSON *sl_catalog_list_views_json(sqlite3 *db);
+/* Stores or replaces a named path (path_json already checked by the
+ * caller, with its key count and last key time); SL_ERR_LIMIT when the
+ * text is over SL_CATALOG_MAX_PATH_BYTES or, for a new name,
+ * SL_CATALOG_MAX_PATHS paths exist. */
+sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *technique, const char *path_json,
+                               int keys, double duration, sl_err *err);
+/* *path receives the stored path object, or NULL when no path has that name. */
+sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err);
+/* [{name, technique, keys, duration, created}] by name. */
+cJSON *sl_catalog_list_paths_json(sqlite3 *db);
 sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *state_json, sl_err *err);
 sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err);
 /* Sessions live in memory; rows left by a previous run are removed at start. */

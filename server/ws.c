@@ -406,6 +406,26 @@ static void sweep_cb(lws_sorted_usec_list_t *sul)
     lws_sul_schedule(sweep_timer.srv->lws, 0, &sweep_timer.sul, sweep_cb, LWS_US_PER_SEC);
 }
 
+/* Path playback (playback.c): steps every playing session, then sleeps until the next step is due. */
+static struct {
+    sl_server *srv;
+    lws_sorted_usec_list_t sul;
+} play_timer;
+
+static void play_cb(lws_sorted_usec_list_t *sul)
+{
+    (void)sul;
+    double next_ms = sl_play_tick(play_timer.srv);
+    if (next_ms >= 0)
+        lws_sul_schedule(play_timer.srv->lws, 0, &play_timer.sul, play_cb, (lws_usec_t)(next_ms * 1000.0) + 1);
+}
+
+void sl_ws_play_schedule(sl_server *srv, double ms)
+{
+    play_timer.srv = srv;
+    lws_sul_schedule(srv->lws, 0, &play_timer.sul, play_cb, (lws_usec_t)(ms * 1000.0) + 1);
+}
+
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
 {
     lws_set_log_level(LLL_ERR | LLL_WARN, NULL);

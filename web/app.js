@@ -69,6 +69,7 @@ window.sightline = {
   get progressStage() { return progress.stage; },
   get timings() { return progress.timings; },
   get recording() { return flight.lastJob; },
+  get playback() { return flight.lastPlayback; },
 };
 const flight = new FlightPanel($('flight'), {
   send: (msg) => conn.send(msg),
@@ -102,6 +103,7 @@ function refreshRole() {
   $('technique').disabled = !ctl;
   $('load-view').disabled = !ctl;
   $('save-view').disabled = !ctl;
+  flight.setEnabled(ctl);
 }
 
 function techniqueByName(name) {
@@ -287,6 +289,7 @@ conn.addEventListener('message', (ev) => {
       setBanner('');
       progress.hide();
       conn.send({ type: 'list_views' });
+      conn.send({ type: 'list_paths' });
       break;
     case 'state':
       applyState(msg.patch || {});
@@ -321,6 +324,18 @@ conn.addEventListener('message', (ev) => {
       break;
     case 'recording':
       flight.update(msg);
+      break;
+    case 'playback':
+      flight.playback(msg);
+      break;
+    case 'paths':
+      flight.listed(msg.paths || []);
+      break;
+    case 'path_saved':
+      conn.send({ type: 'list_paths' });
+      break;
+    case 'path':
+      flight.loaded(msg);
       break;
     case 'error':
       if (msg.code === 'load_failed') progress.hide();

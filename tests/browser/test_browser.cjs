@@ -26,7 +26,11 @@
 // the new frame), "load view" (the saved view's dataset, technique, params
 // and camera come back), and control hand-over to the second page (request,
 // grant, the new controller's change reaches the server, the old one's
-// controls are disabled). Screenshots go to <source>/build/ (CI artifact).
+// controls are disabled), the Flight panel (two keys recorded into a video
+// fetched once; Play: `playback` playing then stopped at the end, the frame
+// id advancing and the camera on the last key; a drag of the timeline puts
+// the server's camera between the keys; the keys saved by name, cleared and
+// loaded back). Screenshots go to <source>/build/ (CI artifact).
 // Prints "N passed, N failed".
 'use strict';
 
@@ -268,6 +272,14 @@ async function driveControls(page, obs, sess, saved) {
   // at 4 frames per second into an MP4 on the server; progress reaches the
   // page, the download link fetches the video once (a second fetch is 410).
   await page.click('#flight .add-key');
+  // The camera's heading in degrees about +y, for either camera form.
+  const heading = () => page.evaluate(() => {
+    const c = window.sightline.state?.camera;
+    if (!c) return NaN;
+    if (c.orbit) return c.orbit.azimuth;
+    return Math.atan2(c.eye[0] - c.target[0], c.eye[2] - c.target[2]) * 180 / Math.PI;
+  });
+  const az0 = await heading();
   const box0 = await page.locator('#view').boundingBox();
   await page.mouse.move(box0.x + box0.width / 2, box0.y + box0.height / 2);
   await page.mouse.down();
@@ -292,6 +304,46 @@ async function driveControls(page, obs, sess, saved) {
   check(fetched.first === 200 && fetched.type === 'video/mp4' && fetched.bytes > 1000 && fetched.second === 410,
     `the download link: ${JSON.stringify(fetched)}`);
   await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-flight.png') });
+
+  // Play: the server plays the two keys live (2 s at 4 fps); the frame id
+  // advances and the session ends on the last key. Then a drag of the
+  // timeline to its middle: the server's camera there lies between the keys.
+  const az1 = await heading();
+  const playFrom = await page.evaluate(() => window.sightline.lastFrame.frameId);
+  await page.click('#flight .play');
+  await page.waitForFunction(() => window.sightline.playback?.state === 'playing', null, { timeout: 30000 });
+  await page.waitForFunction(() => window.sightline.playback?.state === 'stopped', null, { timeout: 30000 });
+  await settled(page);
+  const played = await page.evaluate(() => ({ pb: window.sightline.playback, frame: window.sightline.lastFrame.frameId }));
+  played.az = await heading();
+  check(played.pb.reason === 'end' && played.frame >= playFrom + 3 && Math.abs(played.az - az1) < 1e-3,
+    `Play: ${JSON.stringify(played.pb)}, frame ${playFrom} -> ${played.frame}, azimuth ${played.az} (last key ${az1})`);
+  const tl = await page.locator('#flight .timeline').boundingBox();
+  await page.mouse.move(tl.x + 2, tl.y + tl.height / 2);
+  await page.mouse.down();
+  for (let i = 1; i <= 6; i++) await page.mouse.move(tl.x + 2 + (tl.width / 2 - 2) * i / 6, tl.y + tl.height / 2);
+  await page.mouse.up();
+  const lo = Math.min(az0, az1), hi = Math.max(az0, az1);
+  let azMid = NaN;
+  for (let i = 0; i < 150 && !(azMid > lo + 1e-3 && azMid < hi - 1e-3); i++) {
+    await page.waitForTimeout(100);
+    azMid = await heading();
+  }
+  const between = azMid > lo + 1e-3 && azMid < hi - 1e-3;
+  check(between && Math.abs(az0 - az1) > 1, `timeline drag: azimuth ${azMid} between the keys' ${az0} and ${az1}`);
+  await settled(page);
+
+  // The keys saved as a named path in the catalog, cleared, and loaded back.
+  await page.fill('#flight .path-name', 'browser flight');
+  await page.click('#flight .save-path');
+  await page.waitForFunction(() => [...document.querySelectorAll('#flight .paths option')].some((o) => o.value === 'browser flight'),
+    null, { timeout: 15000 });
+  await page.click('#flight .clear-keys');
+  await page.selectOption('#flight .paths', 'browser flight');
+  await page.click('#flight .load-path');
+  await page.waitForFunction(() => document.querySelectorAll('#flight .keys .key').length === 2, null, { timeout: 15000 })
+    .then(() => {}, () => {});
+  check((await page.$$eval('#flight .keys .key', (ks) => ks.length)) === 2, 'the saved path loads back as two keyframes');
 
   // Technique picker: the server switches, the controls follow the new schema.
   const tech = 'tubes';

@@ -71,29 +71,30 @@ voxel_render_test(voxel_lines.edge_padding
 # Golden images (llvmpipe, 128x128, samples 1): opaque, transparent, shadowed and
 # AO voxel_lines frames, transparent with soft shadows + AO, hard shadows from
 # representative lines (shadow_mode = lines, level 1), and a lines_oit frame.
-# ao.golden.png was regenerated when ao_rays went from 64 to 100 (mean change 0.09). Limits, over
+# The ao golden was regenerated when ao_rays went from 64 to 100 (mean change 0.09). The suite
+# tests/render/voxel_lines/goldens runs through sightline-regress: each case an expect file
+# naming a scene of this folder; limits (suite.json, the ones the per-scene tests had), over
 # the covered pixels (either image differs from the background, SL_GOLDEN_BACKGROUND): mean
-# |diff| <= 1 and at most 0.5 % of them off by more than 8 (0..255). Regenerate a golden with
-# sightline-render --scene S.json --out S.golden.png --samples 1 after a
-# deliberate change, and say so in the commit.
+# |diff| <= 1 and at most 0.5 % of them off by more than 8 (0..255), samples 1. After a
+# deliberate change: sightline-regress tests/render/voxel_lines/goldens --update, look at the
+# new goldens, and say so in the commit.
 set(VOXEL_GOLDEN_LIMITS --max-mean 1 --max-bad-pct 0.5 ${SL_GOLDEN_BACKGROUND})
 string(REPLACE ";" "|" VOXEL_GOLDEN_ARGS "${VOXEL_GOLDEN_LIMITS}")
-foreach(scene opaque transparent shadows ao transparent_lit shadow_lines lines_oit)
-  voxel_render_test(voxel_lines.golden_${scene}
-    ${CMAKE_COMMAND}
-    "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${VOXEL_DIR}/${scene}.json|--out|${SL_RENDER_OUT}/voxel_${scene}.png|--samples|1"
-    "-DSTEP2=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_${scene}.png|${VOXEL_DIR}/${scene}.golden.png|--diff|${SL_RENDER_OUT}/voxel_${scene}.diff.png|${VOXEL_GOLDEN_ARGS}"
-    ${SL_STEPS})
-endforeach()
+file(MAKE_DIRECTORY ${SL_RENDER_OUT}/voxel_lines)
+voxel_render_test(voxel_lines.goldens
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-regress>|${VOXEL_DIR}/goldens|--out|${SL_RENDER_OUT}/voxel_lines/goldens|--jobs|2|--junit|${SL_RENDER_OUT}/voxel_lines/goldens.xml"
+  "-DOUT1=7 cases, 7 passed, 0 failed, 0 errors"
+  ${SL_STEPS})
 # The limits catch a uniform error: +3 on every drawn pixel of the lines_oit
 # golden (28 % of the frame drawn) is a covered mean of 3, over 1; over the
 # whole frame it was 0.83 with no pixel over 8, and passed (step 2).
 voxel_render_test(voxel_lines.golden_detects_uniform_error
   ${CMAKE_COMMAND}
-  "-DSTEP1=$<TARGET_FILE:golden-offset>|${VOXEL_DIR}/lines_oit.golden.png|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|26,26,31|3"
-  "-DSTEP2=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|${VOXEL_DIR}/lines_oit.golden.png|--max-mean|1|--max-bad-pct|0.5"
+  "-DSTEP1=$<TARGET_FILE:golden-offset>|${VOXEL_DIR}/goldens/golden/lines_oit.png|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|26,26,31|3"
+  "-DSTEP2=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|${VOXEL_DIR}/goldens/golden/lines_oit.png|--max-mean|1|--max-bad-pct|0.5"
   "-DOUT2=\"pass\":[ \t]*true"
-  "-DSTEP3=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|${VOXEL_DIR}/lines_oit.golden.png|${VOXEL_GOLDEN_ARGS}"
+  "-DSTEP3=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_lines_oit_plus3.png|${VOXEL_DIR}/goldens/golden/lines_oit.png|${VOXEL_GOLDEN_ARGS}"
   -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_mean\"\\]"
   ${SL_STEPS})
 

@@ -50,6 +50,30 @@ int main(void)
     snprintf(longtok, sizeof longtok, "{\"type\":\"hello\",\"version\":1,\"token\":\"%0100d\"}", 0);
     SL_CHECK(fails_with(longtok, "bad_field", "token"));
 
+    /* playback and named paths (the path itself is checked by the server: sl_scene_path_parse) */
+    SL_CHECK(parse("{\"type\":\"play_path\",\"path\":{\"fps\":2},\"loop\":true}") == SL_OK);
+    SL_CHECK(msg.type == SL_MSG_PLAY_PATH && msg.loop == 1 && cJSON_IsObject(msg.path));
+    SL_CHECK(parse("{\"type\":\"play_path\",\"path\":{}}") == SL_OK && msg.loop == 0);
+    SL_CHECK(fails_with("{\"type\":\"play_path\",\"path\":{},\"loop\":1}", "bad_field", "loop"));
+    SL_CHECK(fails_with("{\"type\":\"play_path\",\"path\":[]}", "bad_field", "path"));
+    SL_CHECK(fails_with("{\"type\":\"play_path\",\"path\":{},\"speed\":2}", "bad_field", "speed"));
+    SL_CHECK(parse("{\"type\":\"play_stop\"}") == SL_OK && msg.type == SL_MSG_PLAY_STOP);
+    SL_CHECK(parse("{\"type\":\"path_seek\",\"path\":{},\"t\":2.5}") == SL_OK && msg.type == SL_MSG_PATH_SEEK &&
+             msg.t == 2.5);
+    SL_CHECK(fails_with("{\"type\":\"path_seek\",\"path\":{}}", "bad_field", "t"));
+    SL_CHECK(fails_with("{\"type\":\"path_seek\",\"path\":{},\"t\":-0.5}", "bad_field", "t"));
+    SL_CHECK(parse("{\"type\":\"save_path\",\"name\":\"a\",\"path\":{}}") == SL_OK && msg.type == SL_MSG_SAVE_PATH &&
+             strcmp(msg.name, "a") == 0 && cJSON_IsObject(msg.path));
+    SL_CHECK(fails_with("{\"type\":\"save_path\",\"name\":\"a\"}", "bad_field", "path"));
+    SL_CHECK(fails_with("{\"type\":\"save_path\",\"name\":\"\",\"path\":{}}", "bad_field", "name"));
+    SL_CHECK(parse("{\"type\":\"load_path\",\"name\":\"a\"}") == SL_OK && msg.type == SL_MSG_LOAD_PATH);
+    SL_CHECK(fails_with("{\"type\":\"load_path\",\"name\":\"a\",\"path\":{}}", "bad_field", "path"));
+    SL_CHECK(parse("{\"type\":\"list_paths\"}") == SL_OK && msg.type == SL_MSG_LIST_PATHS);
+    char *pb = sl_msg_playback_text("stopped", 1.5, 3, 12, 25, 0, "camera");
+    SL_CHECK(pb && strcmp(pb, "{\"type\":\"playback\",\"state\":\"stopped\",\"t\":1.5,\"duration\":3,\"frame\":12,"
+                             "\"frames\":25,\"loop\":false,\"reason\":\"camera\"}") == 0);
+    free(pb);
+
     /* camera */
     SL_CHECK(parse("{\"type\":\"camera\",\"seq\":4294967295,\"phase\":\"move\",\"camera\":{\"orbit\":{}}}") == SL_OK);
     SL_CHECK(msg.type == SL_MSG_CAMERA && msg.seq == 4294967295LL && msg.phase == SL_PHASE_MOVE && cJSON_IsObject(msg.camera));
