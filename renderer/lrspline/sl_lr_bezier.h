@@ -29,7 +29,7 @@
  *   binding LR_COEF_BINDING: float coef[element_count * stride], stride =
  *                            order0*order1*order2*dim, block e at e*stride,
  *                            component c of C_{ijk} at ((k*o1 + j)*o0 + i)*dim + c.
- * The double variant (GL_ARB_gpu_shader_fp64) uses the same layout with
+ * The double variant (GLSL 4.00+ doubles) uses the same layout with
  * dvec4/double at bindings LR_BOX_BINDING_D / LR_COEF_BINDING_D.
  *
  * Any thread for the CPU part; the upload needs the GL context (render
@@ -88,11 +88,16 @@ sl_status sl_lr_bezier_upload(const sl_lr_bezier *bz, int want_double, sl_lr_bez
 void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu);
 void sl_lr_bezier_release(sl_lr_bezier_gpu *gpu);
 
-/* The #defines the GLSL of lr_bezier.glsl needs for this model (orders,
- * dim, bindings, and the element look-up in use: the one place that picks
- * it, see sl_lr_lookup_glsl). Writes at most size bytes. */
+/* The #defines lr_bezier.glsl needs for this model: the orders, dim and
+ * LR_DOUBLE (want_double). Writes at most size bytes. */
 void sl_lr_bezier_defines(const sl_lr_bezier *bz, int want_double, char *out, size_t size);
-/* The embedded GLSL file that provides int lr_find_element(vec3 p). */
-const char *sl_lr_lookup_glsl(void);
+/* Sets the uniforms of lr_bezier.glsl and the look-up (element count,
+ * domain box) on `program` (which must be current). */
+void sl_lr_bezier_set_uniforms(unsigned program, const sl_lr_bezier *bz);
+
+/* Stage files include "lrspline/lr_find.glsl", which pastes lr_bezier.glsl
+ * and the element look-up in use; the look-up's C side (its buffers) is
+ * uploaded and bound by sl_lr_bezier_upload / _bind (lr_bezier_gpu.c,
+ * lookup_upload): those two places pick the look-up. */
 
 #endif

@@ -20,22 +20,8 @@
 
 #include "lrspline/sl_lr.h"
 #include "lrspline/sl_lr_bezier.h"
+#include "lr_test_models.h"
 #include "sl_test.h"
-
-static unsigned long long rng_state = 0x9e3779b97f4a7c15ull;
-static double urand(void)
-{
-    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
-    return (double)(rng_state >> 11) / 9007199254740992.0;
-}
-
-static void coef_random(void *user, const int ijk[3], const double g[3], double *coef)
-{
-    int dim = *(int *)user;
-    (void)ijk;
-    for (int c = 0; c < dim; c++)
-        coef[c] = (urand() * 2.0 - 1.0) * 10.0 + 0.3 * g[0] - g[1] * g[2];
-}
 
 /* Compares at n random points plus the knot-plane lattice; returns the max relative errors. */
 static void compare(const sl_lr_volume *lr, const sl_lr_bezier *bz, int n, const char *name)
@@ -96,41 +82,16 @@ static void compare(const sl_lr_volume *lr, const sl_lr_bezier *bz, int n, const
     free(gb);
 }
 
-/* Open knot vector of `order` on [0, len] with `inner` uneven inner knots. */
-static int make_knots(double *t, int order, int inner, double len)
-{
-    int n = 0;
-    for (int i = 0; i < order; i++)
-        t[n++] = 0.0;
-    for (int i = 1; i <= inner; i++) {
-        double x = (double)i / (inner + 1);
-        t[n++] = len * (x + 0.3 * x * (1 - x) * sin(7.0 * x)); /* strictly increasing, uneven */
-    }
-    for (int i = 0; i < order; i++)
-        t[n++] = len;
-    return n;
-}
-
 static void test_tensor(int o0, int o1, int o2, int dim)
 {
-    int order[3] = {o0, o1, o2};
-    double kx[32], ky[32], kz[32];
-    double *k[3] = {kx, ky, kz};
-    int count[3];
-    count[0] = make_knots(kx, o0, 5, 2.0);
-    count[1] = make_knots(ky, o1, 4, 1.0);
-    count[2] = make_knots(kz, o2, 6, 3.5);
-    if (o1 >= 3) { /* a double inner knot: reduced continuity */
-        ky[o1 + 1] = ky[o1];
-    }
     sl_lr_volume lr;
-    sl_err err;
-    sl_status st = sl_lr_tensor_product(&lr, order, dim, (const double *const *)k, count, coef_random, &dim, &err);
-    SL_CHECK_MSG(st == SL_OK, "tensor product: %s", err.message);
-    if (st != SL_OK)
+    memset(&lr, 0, sizeof lr);
+    SL_CHECK(lr_test_tensor(&lr, o0, o1, o2, dim, 0));
+    if (!lr.element_count)
         return;
+    sl_err err;
     sl_lr_bezier bz;
-    st = sl_lr_bezier_build(&lr, &bz, &err);
+    sl_status st = sl_lr_bezier_build(&lr, &bz, &err);
     SL_CHECK_MSG(st == SL_OK, "bezier: %s", err.message);
     if (st == SL_OK) {
         char name[64];
@@ -141,85 +102,21 @@ static void test_tensor(int o0, int o1, int o2, int dim)
     sl_lr_free(&lr);
 }
 
-typedef struct hand_fn { double x[3], y[3]; double gamma; } hand_fn;
-
-/* The locally refined model (x, y linear; z quadratic on [0, 0.4, 1]):
- * the biquadratic... see the header: tensor mesh x, y in {0, 1, 2}, then the
- * line x = 0.5 for y in [0, 1] and the line y = 0.5 for x in [0, 0.5]. */
 static void test_refined(int dim)
 {
-    static const hand_fn fn[] = {
-        {{0, 0, 0.5}, {0, 0, 0.5}, 1.0},
-        {{0, 0, 0.5}, {0, 0.5, 1}, 0.5},
-        {{0, 0.5, 1}, {0, 0, 1}, 1.0},
-        {{0.5, 1, 2}, {0, 0, 1}, 1.0},
-        {{1, 2, 2}, {0, 0, 1}, 1.0},
-        {{0, 0, 1}, {0, 1, 2}, 1.0},
-        {{0, 1, 2}, {0, 1, 2}, 1.0},
-        {{1, 2, 2}, {0, 1, 2}, 1.0},
-        {{0, 0, 1}, {1, 2, 2}, 1.0},
-        {{0, 1, 2}, {1, 2, 2}, 1.0},
-        {{1, 2, 2}, {1, 2, 2}, 1.0},
-    };
-    static const double zk[3][4] = {{0, 0, 0, 0.4}, {0, 0, 0.4, 1}, {0, 0.4, 1, 1}};
-    static const double zk_last[4] = {0.4, 1, 1, 1};
-    static const double box[][4] = { /* x0 x1 y0 y1, z split at 0.4 */
-        {0, 0.5, 0, 0.5}, {0, 0.5, 0.5, 1}, {0.5, 1, 0, 1}, {1, 2, 0, 1}, {0, 1, 1, 2}, {1, 2, 1, 2},
-    };
-    const size_t nfx = sizeof fn / sizeof fn[0], nz = 4, nbox = sizeof box / sizeof box[0];
-    size_t nb = nfx * nz, ne = nbox * 2;
     sl_lr_volume lr;
+    memset(&lr, 0, sizeof lr);
+    SL_CHECK(lr_test_refined(&lr, dim, 0));
+    if (!lr.element_count)
+        return;
     sl_err err;
-    sl_status st = sl_lr_alloc(&lr, nb, 0, ne, ne * nb, &err);
-    SL_CHECK(st == SL_OK);
-    if (st != SL_OK)
-        return;
-    lr.order[0] = 2;
-    lr.order[1] = 2;
-    lr.order[2] = 3;
-    lr.dim = dim;
-    for (size_t f = 0; f < nfx; f++)
-        for (size_t q = 0; q < nz; q++) {
-            sl_lr_basis *b = &lr.basis[f * nz + q];
-            memcpy(b->knots[0], fn[f].x, sizeof fn[f].x);
-            memcpy(b->knots[1], fn[f].y, sizeof fn[f].y);
-            memcpy(b->knots[2], q < 3 ? zk[q] : zk_last, sizeof zk_last);
-            b->gamma = fn[f].gamma;
-            for (int c = 0; c < dim; c++)
-                b->coef[c] = urand() * 4.0 - 2.0;
-        }
-    size_t off = 0;
-    for (size_t e = 0; e < ne; e++) {
-        sl_lr_element *el = &lr.elements[e];
-        const double *bx = box[e / 2];
-        double z0 = (e % 2) ? 0.4 : 0.0, z1 = (e % 2) ? 1.0 : 0.4;
-        double lo[3] = {bx[0], bx[2], z0}, hi[3] = {bx[1], bx[3], z1};
-        memcpy(el->lo, lo, sizeof lo);
-        memcpy(el->hi, hi, sizeof hi);
-        el->basis_offset = (uint32_t)off;
-        for (size_t b = 0; b < nb; b++) {
-            int in = 1;
-            for (int d = 0; d < 3; d++)
-                in &= lr.basis[b].knots[d][0] <= lo[d] && hi[d] <= lr.basis[b].knots[d][lr.order[d]];
-            if (in)
-                lr.element_basis[off++] = (uint32_t)b;
-        }
-        el->basis_count = (uint32_t)(off - el->basis_offset);
-    }
-    lr.element_basis_count = off;
-    st = sl_lr_finish(&lr, &err);
-    SL_CHECK_MSG(st == SL_OK, "hand-refined model refused: %s", err.message);
-    if (st != SL_OK) {
-        sl_lr_free(&lr);
-        return;
-    }
     /* Different basis lists: the refined corner element has other functions than the far one. */
     SL_CHECK(lr.elements[0].basis_count != lr.elements[10].basis_count ||
              memcmp(lr.element_basis + lr.elements[0].basis_offset,
                     lr.element_basis + lr.elements[10].basis_offset,
                     sizeof(uint32_t) * lr.elements[0].basis_count) != 0);
     sl_lr_bezier bz;
-    st = sl_lr_bezier_build(&lr, &bz, &err);
+    sl_status st = sl_lr_bezier_build(&lr, &bz, &err);
     SL_CHECK_MSG(st == SL_OK, "bezier: %s", err.message);
     if (st == SL_OK) {
         compare(&lr, &bz, 100000, dim == 1 ? "locally refined dim 1" : "locally refined dim 3");
