@@ -9,13 +9,14 @@ int lr_find_element(vec3 p)
 {
     if (!all(greaterThanEqual(p, u_lr_domain_lo)) || !all(lessThanEqual(p, u_lr_domain_hi)))
         return -1; // also NaN
-    for (int e = 0; e < u_lr_element_count; e++) {
+    int found = -1;
+    for (int e = 0; e < u_lr_element_count && found < 0; e++) {
         vec3 lo = lr_box_data[e].lo.xyz, hi = lr_box_data[e].hi.xyz;
         bvec3 upper = bvec3(p.x == hi.x && hi.x == u_lr_domain_hi.x, p.y == hi.y && hi.y == u_lr_domain_hi.y,
                             p.z == hi.z && hi.z == u_lr_domain_hi.z);
         bvec3 below = lessThan(p, hi);
         if (all(greaterThanEqual(p, lo)) && all(bvec3(below.x || upper.x, below.y || upper.y, below.z || upper.z)))
-            return e;
+            found = e;
     }
-    return -1;
+    return found;
 }

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"
 #include "lrspline/sl_lr.h"
 #include "lrspline/sl_lr_bezier.h"
@@ -187,6 +188,14 @@ int main(void)
             }
         }
     }
+    /* A generated model of 4096 elements (the linear look-up's scan is long). */
+    sl_dataset *ds = NULL;
+    sl_status st = sl_generate_json("{\"generator\":\"lr_field\",\"field\":\"trilinear_ml\",\"degree\":1,"
+                                    "\"cells\":16}", &ds, &err);
+    SL_CHECK_MSG(st == SL_OK, "lr_field: %s", err.message);
+    if (st == SL_OK)
+        run_model(ds->lr, "lr_field trilinear_ml 16^3", 0);
+    sl_dataset_destroy(ds);
     sl_gpu_destroy(gpu);
     SL_TEST_END();
 }
