@@ -67,15 +67,15 @@ int main(int argc, char **argv)
     sl_bench_options bo;
     sl_bench_options_init(&bo, 4);
     int ew = 160, eh = 90;
-    for (int i = 1; i < argc;) {
-        int r = sl_bench_option(&bo, argc, argv, &i, "bench-lr-volume");
+    for (int i = 1; i < argc; i++) {
+        int r = sl_bench_option(&bo, argc, argv, &i, "bench-lr-volume"); /* leaves i on its last word */
         if (r < 0)
             return 1;
         if (r > 0)
             continue;
         if (strcmp(argv[i], "--error-size") == 0 && i + 1 < argc && sscanf(argv[i + 1], "%dx%d", &ew, &eh) == 2 &&
             ew > 0 && eh > 0 && ew <= 4096 && eh <= 4096) {
-            i += 2;
+            i++;
             continue;
         }
         fprintf(stderr, "usage: bench-lr-volume %s [--error-size WxH]\n", SL_BENCH_OPTIONS_HELP);
