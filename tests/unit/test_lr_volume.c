@@ -16,6 +16,7 @@
  *    the smallest side: mean <= 0.5, max <= 4;
  *  - empty-space skipping by the element hulls (uniform step: it keeps the
  *    lattice) gives the same image bit for bit and skips samples;
+ *  - a vector volume renders (by its magnitude);
  *  - grazing views (elevation +-89.9, the camera's limit) and a camera 1e5 away render without
  *    error, every pixel background or plausibly composited.
  * The placeholder element look-up (a linear scan) keeps the models small:
@@ -207,6 +208,28 @@ static void test_extreme_views(void)
     }
 }
 
+/* A vector volume (dim 3) renders by its magnitude: covered pixels, and not
+ * the image of the scalar field f it is built from (|f (1, x, y)| != f). */
+static void test_vector(void)
+{
+    static const double orbit[3] = {30, 20, 2.5};
+    static uint8_t vec[4 * N], sca[4 * N];
+    const char *p = "{\"transfer_function\":[[0,0,0,0,0],[0.3,1,0.5,0.2,0.4],[1,0.2,0.6,1,0.8]]}";
+    if (!render("lr_volume", "{\"generator\":\"lr_field\",\"degree\":1,\"cells\":4,\"components\":\"vector\"}",
+                p, orbit, vec, NULL) ||
+        !render("lr_volume", "{\"generator\":\"lr_field\",\"degree\":1,\"cells\":4}", p, orbit, sca, NULL))
+        return;
+    double mean;
+    int max;
+    diff(vec, sca, &mean, &max);
+    printf("vector (magnitude) vs scalar field: mean %.3f max %d\n", mean, max);
+    SL_CHECK_MSG(max > 0, "the vector volume rendered as its first component");
+    int lit = 0;
+    for (int i = 0; i < N; i++)
+        lit += vec[4 * i] > 40;
+    SL_CHECK_MSG(lit > 100, "vector volume: only %d lit pixels", lit);
+}
+
 int main(void)
 {
     sl_err err = {0};
@@ -218,6 +241,7 @@ int main(void)
     test_adaptive_converges();
     test_skipping();
     test_extreme_views();
+    test_vector();
     sl_gpu_destroy(gpu);
     SL_TEST_END();
 }
