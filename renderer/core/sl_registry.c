@@ -12,6 +12,7 @@ extern const sl_technique sl_lines_oit_technique;
 extern const sl_technique sl_volume_dvr_technique;
 extern const sl_technique sl_ribbons_technique;
 extern const sl_technique sl_particles_technique;
+extern const sl_technique sl_lr_volume_technique;
 
 static const sl_technique *const techniques[] = {
     &sl_tubes_mesh_technique,
@@ -21,6 +22,7 @@ static const sl_technique *const techniques[] = {
     &sl_volume_dvr_technique,
     &sl_ribbons_technique,
     &sl_particles_technique,
+    &sl_lr_volume_technique,
 };
 
 const sl_technique *const *sl_technique_list(int *count)

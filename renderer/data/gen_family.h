@@ -58,5 +58,6 @@ extern const sl_gen_family sl_gen_marschner_lobb;
 extern const sl_gen_family sl_gen_torus;
 extern const sl_gen_family sl_gen_head;
 extern const sl_gen_family sl_gen_ellipsoid;
+extern const sl_gen_family sl_gen_lr_field;
 
 #endif

@@ -21,7 +21,7 @@
 
 static const sl_gen_family *const families[] = {
     &sl_gen_tornado, &sl_gen_abc, &sl_gen_bundle, &sl_gen_furball, &sl_gen_hotroom, &sl_gen_random_walk,
-    &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head, &sl_gen_ellipsoid,
+    &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head, &sl_gen_ellipsoid, &sl_gen_lr_field,
 };
 #define FAMILY_COUNT ((int)(sizeof families / sizeof families[0]))
 

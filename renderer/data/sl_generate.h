@@ -9,7 +9,7 @@
  * exp may differ by an ulp between libm versions or with FMA); test_generate
  * pins both per family.
  * Families — lines: tornado, abc, bundle, furball, hotroom, random_walk;
- *            volumes: marschner_lobb, torus, head, ellipsoid.
+ *            volumes: marschner_lobb, torus, head, ellipsoid; LR-spline volumes: lr_field.
  * Any thread; no GL.
  */
 #ifndef SL_GENERATE_H

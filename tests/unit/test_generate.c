@@ -1047,11 +1047,12 @@ static void test_catalog(void)
 {
     int n = 0;
     const sl_generator_info *g = sl_generator_list(&n);
-    SL_CHECK(n == 10);
+    SL_CHECK(n == 11);
     static const sl_gen_family *fams[] = {&sl_gen_tornado, &sl_gen_abc,           &sl_gen_bundle,
                                           &sl_gen_furball, &sl_gen_hotroom,       &sl_gen_random_walk,
-                                          &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head, &sl_gen_ellipsoid};
-    for (int i = 0; i < 10; i++) {
+                                          &sl_gen_marschner_lobb, &sl_gen_torus, &sl_gen_head, &sl_gen_ellipsoid,
+                                          &sl_gen_lr_field};
+    for (int i = 0; i < 11; i++) {
         int listed = 0;
         for (int j = 0; j < n; j++)
             listed |= strcmp(g[j].name, fams[i]->name) == 0 && g[j].kind == fams[i]->kind;
@@ -1072,7 +1073,7 @@ static void test_catalog(void)
                              "%s: default of '%s' out of its range", fams[i]->name, fams[i]->keys[k].name);
         }
         /* The ellipsoid has no randomness and no seed (its 8 keys are the SL_GEN_MAX_KEYS limit). */
-        SL_CHECK_MSG(has_seed != (fams[i] == &sl_gen_ellipsoid), "%s: seed key %s", fams[i]->name,
+        SL_CHECK_MSG(has_seed != (fams[i] == &sl_gen_ellipsoid || fams[i] == &sl_gen_lr_field), "%s: seed key %s", fams[i]->name,
                      has_seed ? "present, not expected" : "missing");
     }
     const sl_builtin_dataset *b = sl_builtin_datasets(&n);
