@@ -27,6 +27,8 @@
 
 static const char *const mode_names[] = {"composite", "mip", NULL};
 static const char *const step_mode_names[] = {"adaptive", "uniform", NULL};
+/* In the order of sl_lr_lookup_kind. */
+static const char *const lookup_names[] = {"auto", "texture", "octree", "kdtree", "kdforest", NULL};
 
 static const sl_param_def lr_volume_params[] = {
     {"transfer_function", SL_PARAM_TRANSFER, 0, 0, {0, SL_TF_AUTO_OPACITY, 0}, NULL, "data",
@@ -49,9 +51,14 @@ static const sl_param_def lr_volume_params[] = {
     {"empty_space_skipping", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
      "jump over elements whose value hull (convex hull of the Bézier coefficients) cannot contribute (same image)",
      SL_INVALIDATE_FRAME},
+    {"lookup", SL_PARAM_ENUM, 0, 0, {0}, lookup_names, "",
+     "element look-up (paper 3.2): auto = texture where the knots lie on a regular grid, else the k-d forest; "
+     "octree needs dyadic knots (refused otherwise)", SL_INVALIDATE_PREPARED},
+    {"forest_blocks", SL_PARAM_INT, 0, 128, {0}, NULL, "",
+     "kdforest: blocks per direction (0: the default, 32)", SL_INVALIDATE_PREPARED},
 };
 
-enum { UNIT_TF = 1, ROWS_BINDING = 5, VISIBLE_BINDING = 10, PROXY_N = 48, MAX_STEPS = 1 << 16 };
+enum { UNIT_TF = 1, ROWS_BINDING = 5, VISIBLE_BINDING = 4, PROXY_N = 48, MAX_STEPS = 1 << 16 };
 
 typedef struct lr_volume_state {
     const sl_lr_volume *lr;        /* borrowed from the dataset */
@@ -158,7 +165,6 @@ static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
                                    sl_err *err)
 {
     (void)gpu;
-    (void)params;
     *out = NULL;
     if (ds->kind != SL_DATASET_LR || !ds->lr)
         return sl_err_set(err, SL_ERR_INVALID, "lr_volume: the dataset is not an LR-spline volume");
@@ -168,7 +174,8 @@ static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     s->lr = ds->lr;
     s->ref = fmin(fmin(ds->lr->min_side[0], ds->lr->min_side[1]), ds->lr->min_side[2]);
     double t_pre = sl_clock_ms();
-    sl_status st = sl_lr_bezier_build(s->lr, &s->bz, err);
+    sl_status st = sl_lr_bezier_build(s->lr, (sl_lr_lookup_kind)sl_params_choice(params, "lookup"),
+                                      sl_params_int(params, "forest_blocks"), &s->bz, err);
     if (st == SL_OK)
         st = build_proxy(s, err);
     if (st == SL_OK && !(s->table = malloc(sizeof *s->table)))
@@ -276,7 +283,7 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
     sl_camera_ubo_update(&s->camera_ubo, view);
     glUseProgram(p);
     sl_lr_bezier_set_uniforms(p, &s->bz);
-    sl_lr_bezier_bind(&s->blocks);
+    sl_lr_bezier_bind(&s->blocks, p);
     glUniform3f(glGetUniformLocation(p, "u_background"), view->background[0], view->background[1],
                 view->background[2]);
     glUniform1i(glGetUniformLocation(p, "u_adaptive"), sl_params_choice(params, "step_mode") == 0);

@@ -34,7 +34,7 @@ uniform int u_skipping;
 uniform int u_max_steps;       // guard against a stalled ray
 
 layout(std430, binding = 5) buffer lr_rows { uint lr_row_counts[]; };  // per row: taken, skipped
-layout(std430, binding = 10) readonly buffer lr_visible { uint lr_visible_data[]; }; // per element: 1 visible
+layout(std430, binding = 4) readonly buffer lr_visible { uint lr_visible_data[]; }; // per element: 1 visible
 
 layout(location = 0) out vec4 o_color;
 

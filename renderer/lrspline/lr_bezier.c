@@ -78,6 +78,7 @@ void sl_lr_bezier_free(sl_lr_bezier *bz)
     free(bz->coef);
     free(bz->hull_min);
     free(bz->hull_max);
+    sl_lr_lookup_deinit(&bz->lookup);
     memset(bz, 0, sizeof *bz);
 }
 
@@ -115,7 +116,18 @@ static void block_hull(const double *c, size_t n, int dim, double *lo, double *h
     *hi = mag;
 }
 
-sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *err)
+static sl_status build_blocks(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *err);
+
+sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_lookup_kind lookup, int forest_axis,
+                             sl_lr_bezier *bz, sl_err *err)
+{
+    sl_status st = build_blocks(lr, bz, err);
+    if (st == SL_OK && (st = sl_lr_lookup_init(&bz->lookup, lr, lookup, forest_axis, err)) != SL_OK)
+        sl_lr_bezier_free(bz);
+    return st;
+}
+
+static sl_status build_blocks(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *err)
 {
     memset(bz, 0, sizeof *bz);
     size_t n = (size_t)lr->order[0] * (size_t)lr->order[1] * (size_t)lr->order[2];

@@ -1,8 +1,8 @@
 /* lr_bezier_gpu.c — the GPU side of the Bézier blocks (sl_lr_bezier.h): the
  * shader storage buffers (float always, double on request), their bindings,
  * the uniforms and #defines of lr_bezier.glsl, and the element look-up's
- * buffers (lookup_upload / lookup_bind: with lr_find.glsl the one place
- * that picks the look-up). Render thread (needs the GL context). */
+ * buffers (made, bound and freed with the blocks; lr_find.glsl pastes its
+ * GLSL). Render thread (needs the GL context). */
 #include "sl_lr_bezier.h"
 
 #include <math.h>
@@ -12,20 +12,14 @@
 
 #include "../gpu/sl_gpu.h"
 
-/* The look-up in use: the linear scan of lr_lookup_linear.glsl reads only the
- * block boxes, so it uploads and binds nothing. The real structures
- * (lr_lookup*.c, lr_lookup.glsl) go here and in lr_find.glsl. */
+/* The element look-up travels with the blocks: its buffers are made and
+ * bound here, its kind is compiled in by sl_lr_bezier_defines. */
 static sl_status lookup_upload(const sl_lr_bezier *bz, sl_lr_bezier_gpu *gpu, sl_err *err)
 {
-    (void)bz;
-    (void)gpu;
-    (void)err;
-    return SL_OK;
-}
-
-static void lookup_bind(const sl_lr_bezier_gpu *gpu)
-{
-    (void)gpu;
+    sl_status st = sl_lr_lookup_gpu_init(&gpu->lookup, &bz->lookup, 0, err);
+    if (st == SL_OK)
+        gpu->bytes += gpu->lookup.bytes;
+    return st;
 }
 
 static sl_status make_buffer(GLuint *buf, const void *data, size_t bytes, const char *what, sl_err *err)
@@ -92,7 +86,7 @@ sl_status sl_lr_bezier_upload(const sl_lr_bezier *bz, int want_double, sl_lr_bez
     return st;
 }
 
-void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu)
+void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu, unsigned program)
 {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SL_LR_BOX_BINDING, gpu->box_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SL_LR_COEF_BINDING, gpu->coef_buffer);
@@ -100,7 +94,7 @@ void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SL_LR_BOX_BINDING_D, gpu->box_buffer_d);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SL_LR_COEF_BINDING_D, gpu->coef_buffer_d);
     }
-    lookup_bind(gpu);
+    sl_lr_lookup_gpu_bind(&gpu->lookup, program);
 }
 
 void sl_lr_bezier_release(sl_lr_bezier_gpu *gpu)
@@ -111,13 +105,15 @@ void sl_lr_bezier_release(sl_lr_bezier_gpu *gpu)
     for (int i = 0; i < 4; i++)
         if (b[i])
             glDeleteBuffers(1, &b[i]);
+    sl_lr_lookup_gpu_deinit(&gpu->lookup);
     memset(gpu, 0, sizeof *gpu);
 }
 
 void sl_lr_bezier_defines(const sl_lr_bezier *bz, int want_double, char *out, size_t size)
 {
     snprintf(out, size, "#define LR_O0 %d\n#define LR_O1 %d\n#define LR_O2 %d\n#define LR_DIM %d\n"
-             "#define LR_DOUBLE %d\n", bz->order[0], bz->order[1], bz->order[2], bz->dim, want_double ? 1 : 0);
+             "#define LR_DOUBLE %d\n%s", bz->order[0], bz->order[1], bz->order[2], bz->dim, want_double ? 1 : 0,
+             sl_lr_lookup_glsl_define(bz->lookup.kind));
 }
 
 void sl_lr_bezier_set_uniforms(unsigned program, const sl_lr_bezier *bz)

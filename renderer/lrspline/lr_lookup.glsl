@@ -1,19 +1,19 @@
 // lr_lookup.glsl — int lr_find_element(vec3 p): the element containing p
 // under the element rule of lrspline/sl_lr.h (half-open boxes, closed at the
 // domain's upper face), -1 outside the domain or for NaN. The GPU form of
-// sl_lr_lookup (layout, bindings 8..10 and uniforms documented in
+// sl_lr_lookup (layout, bindings 10..12 and uniforms documented in
 // sl_lr_lookup.h, filled by sl_lr_lookup_gpu_bind). Planes are stored as the
 // float just at or above their double value, so float points get exactly the
 // CPU (double) answer. Kind: LR_LOOKUP_KIND (1 texture, 2 octree, 3 kdtree,
 // 4 kdforest) when #defined at program build, else the uniform lr_lookup_kind.
 // LR_LOOKUP_HEADS_TEXTURE #defined: the heads are read from the GL_R32UI 3D
-// texture on unit 8 (lr_lookup_heads_tex) instead of binding 8, as in the
+// texture on unit 8 (lr_lookup_heads_tex) instead of binding 10, as in the
 // paper (measured against the SSBO in bench-lr-lookup).
 // Includable (no #version); reads only its own buffers and uniforms.
 
-layout(std430, binding = 8) readonly buffer LrLookupHeads { uint lr_heads[]; };
-layout(std430, binding = 9) readonly buffer LrLookupNodes { uint lr_nodes[]; };
-layout(std430, binding = 10) readonly buffer LrLookupPlanes { float lr_planes[]; };
+layout(std430, binding = 10) readonly buffer LrLookupHeads { uint lr_heads[]; };
+layout(std430, binding = 11) readonly buffer LrLookupNodes { uint lr_nodes[]; };
+layout(std430, binding = 12) readonly buffer LrLookupPlanes { float lr_planes[]; };
 
 uniform ivec3 lr_lookup_n;
 uniform vec3 lr_lookup_lo;

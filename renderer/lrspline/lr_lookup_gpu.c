@@ -1,5 +1,5 @@
 /* lr_lookup_gpu.c — the flattened GPU form of an sl_lr_lookup (layout in
- * sl_lr_lookup.h, read by lr_lookup.glsl): three SSBOs at bindings 8..10,
+ * sl_lr_lookup.h, read by lr_lookup.glsl): three SSBOs at bindings 10..12,
  * the heads also as a 3D texture on unit 8, and the uniforms of a program.
  * Planes go to the float at or above their double value and the domain
  * inwards, which keeps float queries exact.

@@ -42,6 +42,7 @@
 
 #include "../core/sl_status.h"
 #include "sl_lr.h"
+#include "sl_lr_lookup.h"
 
 typedef struct sl_lr_bezier {
     int order[3];
@@ -52,6 +53,7 @@ typedef struct sl_lr_bezier {
     double *coef;           /* element_count * stride, layout as above */
     double *hull_min, *hull_max; /* per element; the magnitude for vectors */
     double hull_lo, hull_hi; /* over all elements */
+    sl_lr_lookup lookup;    /* the element look-up the GPU uses (sl_lr_lookup.h), built with the blocks */
 } sl_lr_bezier;
 
 /* Bernstein coefficients beta[0..order-1] of the piece of the univariate
@@ -59,9 +61,13 @@ typedef struct sl_lr_bezier {
  * must hold [a, b]); all 0 when none does. */
 void sl_lr_bernstein_piece(const double *t, int order, double a, double b, double *beta);
 
-/* Converts every element of a finished model. SL_ERR_NOMEM, SL_ERR_LIMIT
- * (blocks above 2^31 floats: the GPU buffers' index range). */
-sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *err);
+/* Converts every element of a finished model and builds the element look-up
+ * of the given kind (SL_LR_LOOKUP_AUTO: the texture where the knots allow,
+ * else the k-d forest; forest_axis 0: the default). SL_ERR_NOMEM,
+ * SL_ERR_LIMIT (blocks above 2^31 floats: the GPU buffers' index range), the
+ * look-up's refusals (an octree on non-dyadic knots, ...). */
+sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_lookup_kind lookup, int forest_axis,
+                             sl_lr_bezier *bz, sl_err *err);
 void sl_lr_bezier_free(sl_lr_bezier *bz);
 
 /* Evaluates block `element` at p (any p: the polynomial is extended), by
@@ -75,7 +81,8 @@ typedef struct sl_lr_bezier_gpu {
     unsigned box_buffer, coef_buffer;       /* float, always */
     unsigned box_buffer_d, coef_buffer_d;   /* double, when made with want_double */
     size_t element_count;
-    size_t bytes;                           /* GPU memory held */
+    sl_lr_lookup_gpu lookup;                /* the look-up's buffers (bindings 10..12) */
+    size_t bytes;                           /* GPU memory held, look-up included */
 } sl_lr_bezier_gpu;
 
 #define SL_LR_BOX_BINDING 6
@@ -84,20 +91,21 @@ typedef struct sl_lr_bezier_gpu {
 #define SL_LR_COEF_BINDING_D 9
 
 sl_status sl_lr_bezier_upload(const sl_lr_bezier *bz, int want_double, sl_lr_bezier_gpu *gpu, sl_err *err);
-/* Binds the buffers to their bindings (the double ones when present). */
-void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu);
+/* Binds the buffers to their bindings (the double ones when present) and
+ * the look-up's, setting the look-up's uniforms on `program` (made current). */
+void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu, unsigned program);
 void sl_lr_bezier_release(sl_lr_bezier_gpu *gpu);
 
-/* The #defines lr_bezier.glsl needs for this model: the orders, dim and
- * LR_DOUBLE (want_double). Writes at most size bytes. */
+/* The #defines lr_bezier.glsl and lr_lookup.glsl need for this model: the
+ * orders, dim, LR_DOUBLE (want_double) and LR_LOOKUP_KIND. Writes at most
+ * size bytes. */
 void sl_lr_bezier_defines(const sl_lr_bezier *bz, int want_double, char *out, size_t size);
 /* Sets the uniforms of lr_bezier.glsl and the look-up (element count,
  * domain box) on `program` (which must be current). */
 void sl_lr_bezier_set_uniforms(unsigned program, const sl_lr_bezier *bz);
 
 /* Stage files include "lrspline/lr_find.glsl", which pastes lr_bezier.glsl
- * and the element look-up in use; the look-up's C side (its buffers) is
- * uploaded and bound by sl_lr_bezier_upload / _bind (lr_bezier_gpu.c,
- * lookup_upload): those two places pick the look-up. */
+ * and the element look-up (lr_lookup.glsl); its buffers are uploaded and
+ * bound with the blocks by sl_lr_bezier_upload / _bind. */
 
 #endif

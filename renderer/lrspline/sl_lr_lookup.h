@@ -133,20 +133,20 @@ long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
 /* ---- GPU form (lr_lookup_gpu.c, lr_lookup.glsl) ----
  *
  * Three std430 SSBOs of 32-bit words, bound to fixed points:
- *   binding 8  LrLookupHeads  { uint lr_heads[]; }  texture/forest/kdtree:
+ *   binding 10 LrLookupHeads  { uint lr_heads[]; }  texture/forest/kdtree:
  *              one word per cell/block, x fastest (as sl_lr_lookup.heads);
  *              octree: one word, the root ref.
- *   binding 9  LrLookupNodes  { uint lr_nodes[]; }  kd: 2 words per node,
+ *   binding 11 LrLookupNodes  { uint lr_nodes[]; }  kd: 2 words per node,
  *              [0] = axis << 30 | index (axis 3 = leaf; index 0x3FFFFFFF =
  *              no element), [1] = floatBitsToUint(split);  octree: 11 words
  *              per split cell, [0..2] mid planes (float bits), [3..10] child
  *              refs (bit 31 leaf, else the cell's index).
- *   binding 10 LrLookupPlanes { float lr_planes[]; } texture/forest: the
+ *   binding 12 LrLookupPlanes { float lr_planes[]; } texture/forest: the
  *              cell/block planes of x (n0+1), then y (n1+1), then z (n2+1).
- *   binding 11 reserved for look-up (unused now).
+ *   (6..9 are the Bézier blocks' of sl_lr_bezier.h.)
  *   texture unit 8: when asked for, the heads again as a GL_R32UI 3D
  *              texture n0 x n1 x n2 (texture/forest/kdtree; read instead of
- *              binding 8 when the shader #defines LR_LOOKUP_HEADS_TEXTURE,
+ *              binding 10 when the shader #defines LR_LOOKUP_HEADS_TEXTURE,
  *              as the paper does; not faster on llvmpipe, see RESULTS.md).
  * Uniforms (set by sl_lr_lookup_gpu_bind on the given program):
  *   ivec3 lr_lookup_n; vec3 lr_lookup_lo, lr_lookup_hi (domain, rounded
@@ -159,9 +159,9 @@ long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
  * domain's lower bound is rounded up and its upper bound down the same way.
  * Float points therefore get exactly the CPU (double) answer.
  */
-#define SL_LR_LOOKUP_BINDING_HEADS 8
-#define SL_LR_LOOKUP_BINDING_NODES 9
-#define SL_LR_LOOKUP_BINDING_PLANES 10
+#define SL_LR_LOOKUP_BINDING_HEADS 10
+#define SL_LR_LOOKUP_BINDING_NODES 11
+#define SL_LR_LOOKUP_BINDING_PLANES 12
 #define SL_LR_LOOKUP_UNIT_HEADS 8
 
 typedef struct sl_lr_lookup_gpu {
@@ -178,7 +178,7 @@ typedef struct sl_lr_lookup_gpu {
  * shaders; skipped above GL_MAX_3D_TEXTURE_SIZE). SL_ERR_GPU on a GL error,
  * SL_ERR_NOMEM; on failure *g owns nothing. deinit is safe on a zeroed *g. */
 sl_status sl_lr_lookup_gpu_init(sl_lr_lookup_gpu *g, const sl_lr_lookup *lk, int heads_texture, sl_err *err);
-/* Binds the buffers to 8..10 and the heads texture to unit 8 and sets the
+/* Binds the buffers to 10..12 and the heads texture to unit 8 and sets the
  * uniforms of `program` (which is made current). */
 void sl_lr_lookup_gpu_bind(const sl_lr_lookup_gpu *g, unsigned int program);
 void sl_lr_lookup_gpu_deinit(sl_lr_lookup_gpu *g);

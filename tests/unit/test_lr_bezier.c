@@ -91,7 +91,7 @@ static void test_tensor(int o0, int o1, int o2, int dim)
         return;
     sl_err err;
     sl_lr_bezier bz;
-    sl_status st = sl_lr_bezier_build(&lr, &bz, &err);
+    sl_status st = sl_lr_bezier_build(&lr, SL_LR_LOOKUP_AUTO, 0, &bz, &err);
     SL_CHECK_MSG(st == SL_OK, "bezier: %s", err.message);
     if (st == SL_OK) {
         char name[64];
@@ -116,7 +116,7 @@ static void test_refined(int dim)
                     lr.element_basis + lr.elements[10].basis_offset,
                     sizeof(uint32_t) * lr.elements[0].basis_count) != 0);
     sl_lr_bezier bz;
-    sl_status st = sl_lr_bezier_build(&lr, &bz, &err);
+    sl_status st = sl_lr_bezier_build(&lr, SL_LR_LOOKUP_AUTO, 0, &bz, &err);
     SL_CHECK_MSG(st == SL_OK, "bezier: %s", err.message);
     if (st == SL_OK) {
         compare(&lr, &bz, 100000, dim == 1 ? "locally refined dim 1" : "locally refined dim 3");

@@ -1,5 +1,5 @@
 /* test_lr_gpu.c — GPU evaluation of LR-spline Bézier blocks
- * (renderer/lrspline/lr_bezier_gpu.c, lr_bezier.glsl, lr_lookup_linear.glsl
+ * (renderer/lrspline/lr_bezier_gpu.c, lr_bezier.glsl, lr_lookup.glsl (the auto look-up)
  * through lr_probe.comp.glsl) against the CPU double reference sl_lr_eval
  * (lr_eval.c, from the LR basis, no Bézier form) on llvmpipe.
  *
@@ -55,7 +55,7 @@ static void run_model(sl_lr_volume *lr, const char *name, int want_double)
 {
     sl_err err;
     sl_lr_bezier bz;
-    sl_status st = sl_lr_bezier_build(lr, &bz, &err);
+    sl_status st = sl_lr_bezier_build(lr, SL_LR_LOOKUP_AUTO, 0, &bz, &err);
     SL_CHECK_MSG(st == SL_OK, "%s: %s", name, err.message);
     if (st != SL_OK)
         return;
@@ -83,7 +83,7 @@ static void run_model(sl_lr_volume *lr, const char *name, int want_double)
         glUseProgram(prog);
         sl_lr_bezier_set_uniforms(prog, &bz);
         glUniform1i(glGetUniformLocation(prog, "u_count"), NPOINTS);
-        sl_lr_bezier_bind(&g);
+        sl_lr_bezier_bind(&g, prog);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, in_buf);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out_buf);
         glDispatchCompute((NPOINTS + 63) / 64, 1, 1);
