@@ -513,7 +513,11 @@ sl_status sl_lr_fit(const sl_dataset *ds, const sl_lr_fit_params *p, sl_lr_volum
         for (int q = 0; q < p->degree; q++)
             knots[d][m++] = s.hi[d];
         h0[d] = ext / cells;
-        min_span[d] = h0[d] / ldexp(1.0, p->max_levels);
+        /* No knot span below two sample spacings: finer elements are not
+         * determined by the samples and the least-squares spline wiggles
+         * between them (seen as element-sized tiles in lr_volume). */
+        double spacing = s.n[d] > 1 ? ext / (s.n[d] - 1) : ext;
+        min_span[d] = fmax(h0[d] / ldexp(1.0, p->max_levels), 2.0 * spacing);
     }
     coef_ctx cc = {&s};
     st = sl_lr_tensor_product(out, order, s.dim, (const double *const *)knots, count, nearest_coef, &cc, err);

@@ -12,7 +12,8 @@
  * Kvamsdal, Dokken 2014, section 5): the basis functions whose support holds
  * an error > tol, largest first, a `fraction` of them per iteration, have
  * every knot span halved over their support (sl_lr_refine_basis), spans not
- * below the finest level h0 / 2^max_levels. Stops at max error <= tol, when
+ * below the finest level h0 / 2^max_levels nor below two sample spacings
+ * (finer spans are not determined by the samples). Stops at max error <= tol, when
  * nothing may be refined (max levels reached), at max_basis functions (the
  * cap, reported) or after max_iterations.
  * Error behaviour: least squares reproduces splines of the space exactly (a

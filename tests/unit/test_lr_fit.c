@@ -115,7 +115,7 @@ static void test_polynomial(void)
 
 static void test_sphere(void)
 {
-    sl_dataset *ds = make_volume(24, 24, 24, 2.0 / 23, sphere);
+    sl_dataset *ds = make_volume(48, 48, 48, 2.0 / 47, sphere);
     SL_CHECK(ds != NULL);
     if (!ds)
         return;
@@ -123,6 +123,7 @@ static void test_sphere(void)
     sl_lr_fit_defaults(&p);
     p.tol = 0.004;
     p.max_levels = 3;
+    p.cells_longest = 4; /* spans of 0.5: halved twice before the floor of two sample spacings (0.085) */
     sl_lr_volume lr;
     sl_lr_fit_stats s;
     sl_err err = {0};
