@@ -107,6 +107,8 @@ static sl_status lr_field_generate(const double *values, sl_dataset **out, sl_er
         const double *const k3[3] = {knots, knots, knots};
         const int count[3] = {n, n, n};
         st = sl_lr_tensor_product(ds->lr, order, dim, k3, count, field_coef, &ctx, err);
+        if (st == SL_OK)
+            st = sl_lr_index(ds->lr, err);
     }
     sl_dataset_destroy(ml);
     free(knots);

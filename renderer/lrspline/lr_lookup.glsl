@@ -15,6 +15,10 @@ layout(std430, binding = 10) readonly buffer LrLookupHeads { uint lr_heads[]; };
 layout(std430, binding = 11) readonly buffer LrLookupNodes { uint lr_nodes[]; };
 layout(std430, binding = 12) readonly buffer LrLookupPlanes { float lr_planes[]; };
 
+// Deeper than any tree sl_lr_lookup builds (k-d: log2 of 8M elements plus
+// imbalance; octree: SL_LR_OCTREE_MAX_LEVEL 30).
+#define LR_LOOKUP_MAX_DEPTH 64
+
 uniform ivec3 lr_lookup_n;
 uniform vec3 lr_lookup_lo;
 uniform vec3 lr_lookup_hi;
@@ -33,10 +37,12 @@ int lr_lookup_cell(float x, int axis, int base)
 {
     int n = lr_lookup_n[axis];
     int c = clamp(int((x - lr_lookup_origin[axis]) * lr_lookup_scale[axis]), 0, n - 1);
-    while (c > 0 && x < lr_planes[base + c])
-        c--;
-    while (c < n - 1 && x >= lr_planes[base + c + 1])
-        c++;
+    // The estimate is off by at most a cell or two (rounding); bounded loops
+    // without early exits (see the k-d traversal below).
+    for (int k = 0; k < 4; k++)
+        c -= c > 0 && x < lr_planes[base + c] ? 1 : 0;
+    for (int k = 0; k < 4; k++)
+        c += c < n - 1 && x >= lr_planes[base + c + 1] ? 1 : 0;
     return c;
 }
 
@@ -51,7 +57,7 @@ int lr_find_element(vec3 p)
 #endif
     if (kind == 2) { // octree: 11 words per split cell
         uint ref = lr_heads[0];
-        while ((ref & 0x80000000u) == 0u) {
+        for (int level = 0; level <= LR_LOOKUP_MAX_DEPTH && (ref & 0x80000000u) == 0u; level++) {
             uint b = ref * 11u;
             vec3 mid = vec3(uintBitsToFloat(lr_nodes[b]), uintBitsToFloat(lr_nodes[b + 1u]),
                             uintBitsToFloat(lr_nodes[b + 2u]));
@@ -59,7 +65,7 @@ int lr_find_element(vec3 p)
             ref = lr_nodes[b + 3u + c];
         }
         uint e = ref & 0x7FFFFFFFu;
-        return e == 0x7FFFFFFFu ? -1 : int(e);
+        return (ref & 0x80000000u) == 0u || e == 0x7FFFFFFFu ? -1 : int(e);
     }
     int cx = lr_lookup_cell(p.x, 0, 0);
     int cy = lr_lookup_cell(p.y, 1, lr_lookup_n.x + 1);
@@ -76,14 +82,16 @@ int lr_find_element(vec3 p)
         return e == 0x7FFFFFFFu ? -1 : int(e);
     }
     // Algorithm 1: [0] = axis << 30 | index, [1] = split; right child next.
-    uint i = head;
-    for (;;) {
-        uint w = lr_nodes[2u * i];
+    // Bounded, one exit after the loop, no dynamic vector index: llvmpipe drew
+    // wrong elements with `for (;;)` + return + p[axis] inside lr_volume's march
+    // (a line of rays across the image where neighbouring pixels part ways).
+    uint i = head, w = lr_nodes[2u * i];
+    for (int level = 0; level <= LR_LOOKUP_MAX_DEPTH && (w >> 30) != 3u; level++) {
         uint axis = w >> 30;
-        if (axis == 3u) {
-            uint e = w & 0x3FFFFFFFu;
-            return e == 0x3FFFFFFFu ? -1 : int(e);
-        }
-        i = p[axis] < uintBitsToFloat(lr_nodes[2u * i + 1u]) ? (w & 0x3FFFFFFFu) : i + 1u;
+        float x = axis == 0u ? p.x : (axis == 1u ? p.y : p.z);
+        i = x < uintBitsToFloat(lr_nodes[2u * i + 1u]) ? (w & 0x3FFFFFFFu) : i + 1u;
+        w = lr_nodes[2u * i];
     }
+    uint e = w & 0x3FFFFFFFu;
+    return (w >> 30) != 3u || e == 0x3FFFFFFFu ? -1 : int(e);
 }
