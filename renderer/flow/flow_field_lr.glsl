@@ -12,7 +12,20 @@
 // double path uses the CPU's element. flow_local_size(): the heuristic
 // size of flow_field.c, min element side / 2^degree (degree = the largest,
 // at least 1). Callers test the domain first; outside, field() is NaN.
+// Defaults for a build without sl_lr_bezier_defines (shaders-check): vector
+// blocks, and the double buffers whenever the precision needs them.
+#ifndef LR_DIM
+#define LR_DIM 3
+#endif
+#if SL_PREC != 0
+#ifndef LR_DOUBLE
+#define LR_DOUBLE 1
+#endif
+#endif
 #include "lrspline/lr_find.glsl"
+#if LR_DIM != 3
+#error "streamlines need an LR-spline volume of dim 3"
+#endif
 #if SL_PREC != 0 && !LR_DOUBLE
 #error "mixed and double LR fields need LR_DOUBLE 1 (the double boxes)"
 #endif
@@ -119,8 +132,7 @@ dvec3 field_d(dvec3 p)
 }
 #endif
 
-// The heuristic local size at p (0 outside the domain).
-#define FLOW_LOCAL_SIZE 1
+// The heuristic local size at p (0 outside the domain); u_step holds H.
 REAL flow_local_size(VEC3 p)
 {
 #if SL_PREC == 0
