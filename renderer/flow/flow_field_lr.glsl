@@ -37,9 +37,19 @@ float flow_nan()
     return uintBitsToFloat(0x7fc00000u);
 }
 
+// The look-up at a point the integrator found inside its domain box (finite):
+// clamped to the look-up's float box, which lies inside the double domain
+// (float_up / float_down of its bounds, lr_lookup_gpu.c), so a point on a
+// face that is not a float (x = 0.9, or a rounded u_lo) still finds its
+// element rather than -1.
+int flow_lr_find(vec3 q)
+{
+    return lr_find_element(clamp(q, lr_lookup_lo, lr_lookup_hi));
+}
+
 vec3 field(vec3 p)
 {
-    int e = lr_find_element(p);
+    int e = flow_lr_find(p);
     if (e < 0)
         return vec3(flow_nan());
     mat3 J;
@@ -72,7 +82,7 @@ float flow_ulp_step(float x, int s)
 int flow_lr_element_d(dvec3 p)
 {
     vec3 q = vec3(p);
-    int e = lr_find_element(q);
+    int e = flow_lr_find(q);
     if (e < 0)
         return -1;
     bool moved = false;
@@ -84,7 +94,7 @@ int flow_lr_element_d(dvec3 p)
         }
     }
     if (moved) {
-        int e2 = lr_find_element(q);
+        int e2 = flow_lr_find(q);
         if (e2 >= 0)
             e = e2;
     }
@@ -136,7 +146,7 @@ dvec3 field_d(dvec3 p)
 REAL flow_local_size(VEC3 p)
 {
 #if SL_PREC == 0
-    int e = lr_find_element(p);
+    int e = flow_lr_find(p);
     if (e < 0)
         return REAL(0);
     vec3 s = lr_box_data[e].hi.xyz - lr_box_data[e].lo.xyz;

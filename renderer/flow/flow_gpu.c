@@ -61,8 +61,8 @@ static sl_status create_lr(const sl_flow_field *f, sl_flow_gpu **out, sl_err *er
     g->has_double = has_doubles();
     g->has_lr = 1;
     sl_status st = sl_lr_bezier_build(f->lr, SL_LR_LOOKUP_AUTO, 0, &g->bz, err);
-    if (st == SL_OK)
-        st = sl_gl_check_errors("before the LR field upload", err);
+    sl_err stale = {0};
+    sl_gl_check_errors("before the LR field upload", &stale); /* clears errors not ours */
     if (st == SL_OK)
         st = sl_lr_bezier_upload(&g->bz, g->has_double, &g->blocks, err);
     if (st != SL_OK) {

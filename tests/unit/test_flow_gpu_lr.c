@@ -1,19 +1,25 @@
 /* test_flow_gpu_lr.c — the compute-shader integrator on LR-spline vector
  * volumes (flow_field_lr.glsl, flow_gpu.c) against the CPU double reference
  * (flow_trace.c on the same sl_lr_volume, sl_lr_eval from the LR basis).
- * Field: the rotation v = (-y, x, 0.2) on [-1, 1]^2 x [0, 1], reproduced
+ * Field: the rotation v = (-y, x, 0.2) on [-1.1, 0.9] x [-1, 1] x [0, 1]
+ * (x bounds not floats: lines leaving through x = 0.9 or -1.1 end on the
+ * double face while the look-up's float box lies inside it), reproduced
  * exactly by a degree-1 tensor product (coefficients = v at the Greville
  * points = the knots) on uneven, non-dyadic knots (so float boxes are
  * rounded), and the same model locally refined by sl_lr_refine (three mesh
  * rectangles, so lines cross elements of different sizes and the look-up
  * works on a refined mesh), and the refined model with its coefficients
  * perturbed (0.05 sin(...)), a field that differs from element to element,
- * so the GPU must evaluate the element the CPU does. 16 Halton seeds, t_max 2 (several lines leave
- * the box: the boundary clip runs). RK4 with a fixed step h = 0.05 and the
+ * so the GPU must evaluate the element the CPU does. 16 Halton seeds and
+ * 2 that leave through the x faces, t_max 2 (several lines leave the box:
+ * the boundary clip runs). RK4 with a fixed step h = 0.05 and the
  * heuristic step (H = 0.5 times the element's min side / 2); sample by
  * sample, max |x_gpu - x_cpu| / (box side 2): double <= 1e-12, mixed <=
- * 1e-7, single <= 1e-5; the same stop reasons; sample counts equal (single:
- * +-1, the float boundary bisection). The CPU line is also checked against
+ * 1e-7, single <= 1e-5, the last samples too; the same stop reasons; sample
+ * counts within +-1: the boundary bisection can end an ulp inside the face
+ * (then one Euler step onto it) or exactly on it (no step), measured on the
+ * CPU at x = 0.89999999999999969 and on the GPU at 0.9 in double, both then
+ * ending on x = 0.9. The CPU line is also checked against
  * the exact rotation (rk4 at h = 0.05: <= 1e-6), so the reference is right.
  * The seed box avoids knots: a seed on a knot, -0.7 in double, is -0.699999988
  * in float, in the next element, so the single heuristic step differs there
@@ -40,7 +46,7 @@ static void rotation(void *user, const int ijk[3], const double g[3], double *co
 
 static int rotation_model(sl_lr_volume *lr, int refine)
 {
-    static const double kx[] = {-1, -1, -0.7, -0.1, 0.35, 0.8, 1, 1};
+    static const double kx[] = {-1.1, -1.1, -0.7, -0.1, 0.35, 0.8, 0.9, 0.9};
     static const double ky[] = {-1, -1, -0.55, 0.15, 0.6, 1, 1};
     static const double kz[] = {0, 0, 0.45, 1, 1};
     const double *k[3] = {kx, ky, kz};
@@ -89,6 +95,11 @@ static void compare(const sl_flow_result *g, const sl_flow_result *c, double bou
             if (!(e <= worst))
                 worst = e;
         }
+        for (int k = 0; dc != 0 && a->count > 0 && b->count > 0 && k < 3; k++) { /* the last samples */
+            double e = fabs(a->x[3 * (a->count - 1) + k] - b->x[3 * (b->count - 1) + k]) / 2.0;
+            if (!(e <= worst))
+                worst = e;
+        }
     }
     SL_CHECK_MSG(worst <= bound, "%s: max relative difference %.3g > %.3g", what, worst, bound);
     SL_CHECK_MSG(count_ok, "%s: sample counts differ", what);
@@ -127,6 +138,16 @@ int main(void)
     double *seeds;
     size_t n;
     SL_CHECK(sl_flow_seeds_box("-0.79,-0.77,0.05,0.81,0.79,0.6,16", &seeds, &n, &err) == SL_OK);
+    /* Two more seeds whose lines leave through the faces x = 0.9 and x = -1.1
+     * (not floats: the look-up's float box lies inside the double domain). */
+    static const double face_seeds[6] = {0.5, -0.8, 0.3, -0.8, 0.85, 0.3};
+    double *more = seeds ? realloc(seeds, (3 * n + 6) * sizeof *seeds) : NULL;
+    SL_CHECK(more != NULL);
+    if (!more)
+        SL_TEST_END();
+    seeds = more;
+    memcpy(seeds + 3 * n, face_seeds, sizeof face_seeds);
+    n += 2;
     for (int refine = 0; refine < 3; refine++) {
         sl_lr_volume lr;
         SL_CHECK(rotation_model(&lr, refine));
@@ -145,6 +166,12 @@ int main(void)
                                  .step = mode ? 0.5 : 0.05};
             sl_flow_result cpu;
             SL_CHECK(sl_flow_trace(&f, seeds, n, &o, &cpu, &err) == SL_OK);
+            for (size_t j = n - 2; j < n; j++) { /* the face seeds end on their x face */
+                const sl_flow_line *l = &cpu.lines[j];
+                double face = j == n - 2 ? 0.9 : -1.1;
+                SL_CHECK_MSG(l->stop == SL_FLOW_STOP_BOUNDARY && l->count > 0 && l->x[3 * (l->count - 1)] == face,
+                             "line %zu: stop %d, does not end on x = %g", j, (int)l->stop, face);
+            }
             if (!mode && refine < 2) {
                 double e = exact_error(&cpu);
                 SL_CHECK_MSG(e <= 1e-6, "cpu rk4 vs the exact rotation: %.3g", e);
@@ -160,7 +187,7 @@ int main(void)
                 snprintf(what, sizeof what, "%s rk4 %s %s", names[refine],
                          mode ? "heuristic" : "fixed", sl_flow_precision_name((sl_flow_precision)p));
                 double bound = p == SL_FLOW_DOUBLE ? 1e-12 : p == SL_FLOW_MIXED ? 1e-7 : 1e-5;
-                compare(&gr, &cpu, bound, p == SL_FLOW_SINGLE ? 1 : 0, what);
+                compare(&gr, &cpu, bound, 1, what);
                 sl_flow_result_free(&gr);
             }
             sl_flow_result_free(&cpu);
