@@ -162,11 +162,7 @@ int main(int argc, char **argv)
     }
     double ms = 0;
     if (st == SL_OK && gpu) {
-        if (f.kind == SL_FLOW_FIELD_LR)
-            st = sl_err_set(&err, SL_ERR_UNSUPPORTED,
-                            "--gpu with an LR-spline volume is not yet available; leave out --gpu for the CPU path");
-        if (st == SL_OK)
-            st = sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &ctx, &err);
+        st = sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &ctx, &err);
         if (st == SL_OK)
             st = sl_flow_gpu_create(&f, &fg, &err);
         if (st == SL_OK)

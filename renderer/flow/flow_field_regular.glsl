@@ -7,6 +7,8 @@
 // full precision. field() in float; field_m() (mixed) the cell and local
 // weights in double, the lerps in float; field_d() in double (the texel
 // values are floats, converted exactly). Callers test the domain first.
+// flow_local_size() is 1: the local size is a constant here, and u_step
+// holds H times it for the heuristic mode (times 1 is exact).
 uniform sampler3D u_field;
 uniform ivec3 u_dims;
 uniform vec3 u_origin_f, u_spacing_f;
@@ -103,3 +105,8 @@ dvec3 field_d(dvec3 p)
     return z0 + w.z * (z1 - z0);
 }
 #endif
+
+REAL flow_local_size(VEC3 p)
+{
+    return REAL(1);
+}

@@ -1,5 +1,6 @@
 /* flow_gpu.c — the compute-shader streamline driver (flow_gpu.h): field
- * texture, one program per precision, the tableau of sl_flow_methods as
+ * texture (regular) or Bézier blocks and element look-up (LR, built and
+ * uploaded once in create, bound per trace), one program per precision, the tableau of sl_flow_methods as
  * uniforms (doubles for mixed / double, so both paths run the same
  * coefficients; b - e subtracted here), seed / sample / info buffers,
  * dispatch, read-back. Render thread only.
@@ -11,6 +12,7 @@
 
 #include "../core/sl_clock.h"
 #include "../gpu/sl_gpu.h"
+#include "../lrspline/sl_lr_bezier.h"
 #include "flow_gpu.h"
 
 #define VARIANTS 3                 /* one program per precision */
@@ -20,6 +22,10 @@ struct sl_flow_gpu {
     GLuint texture;
     GLuint programs[VARIANTS];
     int has_double;
+    /* LR: the blocks and look-up (bz) and their GPU buffers (blocks) */
+    int has_lr;
+    sl_lr_bezier bz;
+    sl_lr_bezier_gpu blocks;
 };
 
 int sl_flow_precision_find(const char *name)
@@ -36,20 +42,51 @@ const char *sl_flow_precision_name(sl_flow_precision p)
     return p == SL_FLOW_SINGLE ? "single" : p == SL_FLOW_MIXED ? "mixed" : p == SL_FLOW_DOUBLE ? "double" : "?";
 }
 
-sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
+static int has_doubles(void)
 {
-    *out = NULL;
-    if (f->kind == SL_FLOW_FIELD_LR)
-        return sl_err_set(err, SL_ERR_UNSUPPORTED,
-                          "GPU streamlines of LR-spline volumes are not yet available "
-                          "(use the CPU path: leave out --gpu)");
-    if (f->kind != SL_FLOW_FIELD_REGULAR)
-        return sl_err_set(err, SL_ERR_UNSUPPORTED, "GPU streamlines need a regular vector field");
+    return epoxy_gl_version() >= 40 || epoxy_has_gl_extension("GL_ARB_gpu_shader_fp64");
+}
+
+/* LR: the Bézier blocks with the look-up (auto kind), uploaded with the
+ * double copies when GL has doubles (mixed needs the double boxes too). */
+static sl_status create_lr(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
+{
+    if (!f->lr || f->lr->dim != 3)
+        return sl_err_set(err, SL_ERR_UNSUPPORTED, "GPU streamlines need an LR-spline volume of dim 3 (got dim %d)",
+                          f->lr ? f->lr->dim : 0);
     sl_flow_gpu *g = calloc(1, sizeof *g);
     if (!g)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the GPU streamline state");
     g->field = *f;
-    g->has_double = epoxy_gl_version() >= 40 || epoxy_has_gl_extension("GL_ARB_gpu_shader_fp64");
+    g->has_double = has_doubles();
+    g->has_lr = 1;
+    sl_status st = sl_lr_bezier_build(f->lr, SL_LR_LOOKUP_AUTO, 0, &g->bz, err);
+    sl_err stale = {0};
+    sl_gl_check_errors("before the LR field upload", &stale); /* clears errors not ours */
+    if (st == SL_OK)
+        st = sl_lr_bezier_upload(&g->bz, g->has_double, &g->blocks, err);
+    if (st != SL_OK) {
+        sl_flow_gpu_destroy(g);
+        return st;
+    }
+    g->field.lr = NULL; /* borrowed only during create */
+    *out = g;
+    return SL_OK;
+}
+
+sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
+{
+    *out = NULL;
+    if (f->kind == SL_FLOW_FIELD_LR)
+        return create_lr(f, out, err);
+    if (f->kind != SL_FLOW_FIELD_REGULAR)
+        return sl_err_set(err, SL_ERR_UNSUPPORTED,
+                          "GPU streamlines need a regular vector field or an LR-spline volume of dim 3");
+    sl_flow_gpu *g = calloc(1, sizeof *g);
+    if (!g)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the GPU streamline state");
+    g->field = *f;
+    g->has_double = has_doubles();
     size_t n = (size_t)f->dims[0] * (size_t)f->dims[1] * (size_t)f->dims[2];
     float *rgba = malloc(4 * n * sizeof *rgba);
     if (!rgba) {
@@ -91,6 +128,10 @@ void sl_flow_gpu_destroy(sl_flow_gpu *g)
             glDeleteProgram(g->programs[i]);
     if (g->texture)
         glDeleteTextures(1, &g->texture);
+    if (g->has_lr) {
+        sl_lr_bezier_release(&g->blocks);
+        sl_lr_bezier_free(&g->bz);
+    }
     free(g);
 }
 
@@ -100,10 +141,12 @@ static sl_status program_for(sl_flow_gpu *g, sl_flow_precision p, GLuint *progra
         *program = g->programs[p];
         return SL_OK;
     }
-    char defines[64];
-    snprintf(defines, sizeof defines, "#define SL_PREC %d\n", (int)p);
-    sl_program_desc d = {.compute = "flow/flow_trace_regular.comp.glsl", .defines = defines,
-                         .label = "flow_trace"};
+    char defines[512];
+    int used = snprintf(defines, sizeof defines, "#define SL_PREC %d\n", (int)p);
+    if (g->has_lr)
+        sl_lr_bezier_defines(&g->bz, p != SL_FLOW_SINGLE, defines + used, sizeof defines - (size_t)used);
+    sl_program_desc d = {.compute = g->has_lr ? "flow/flow_trace_lr.comp.glsl" : "flow/flow_trace_regular.comp.glsl",
+                         .defines = defines, .label = g->has_lr ? "flow_trace_lr" : "flow_trace"};
     sl_status st = sl_gl_program_create(&d, &g->programs[p], err);
     if (st != SL_OK)
         return st;
@@ -224,15 +267,20 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
 
     const sl_flow_field *f = &g->field;
     glUseProgram(program);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_3D, g->texture);
-    glUniform1i(glGetUniformLocation(program, "u_field"), 0);
-    glUniform3i(glGetUniformLocation(program, "u_dims"), f->dims[0], f->dims[1], f->dims[2]);
-    glUniform3f(glGetUniformLocation(program, "u_origin_f"), (float)f->origin[0], (float)f->origin[1],
-                (float)f->origin[2]);
-    glUniform3f(glGetUniformLocation(program, "u_spacing_f"), (float)f->spacing[0], (float)f->spacing[1],
-                (float)f->spacing[2]);
-    if (precision != SL_FLOW_SINGLE) {
+    if (g->has_lr) {
+        sl_lr_bezier_set_uniforms(program, &g->bz);
+        sl_lr_bezier_bind(&g->blocks, program);
+    } else {
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_3D, g->texture);
+        glUniform1i(glGetUniformLocation(program, "u_field"), 0);
+        glUniform3i(glGetUniformLocation(program, "u_dims"), f->dims[0], f->dims[1], f->dims[2]);
+        glUniform3f(glGetUniformLocation(program, "u_origin_f"), (float)f->origin[0], (float)f->origin[1],
+                    (float)f->origin[2]);
+        glUniform3f(glGetUniformLocation(program, "u_spacing_f"), (float)f->spacing[0], (float)f->spacing[1],
+                    (float)f->spacing[2]);
+    }
+    if (!g->has_lr && precision != SL_FLOW_SINGLE) {
         glUniform3d(glGetUniformLocation(program, "u_origin_d"), f->origin[0], f->origin[1], f->origin[2]);
         glUniform3d(glGetUniformLocation(program, "u_spacing_d"), f->spacing[0], f->spacing[1], f->spacing[2]);
     }
@@ -247,8 +295,9 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
     if (h_min > h_max)
         h_min = h_max;
     double step = o->step;
-    if (o->mode == SL_FLOW_STEP_HEURISTIC)
+    if (o->mode == SL_FLOW_STEP_HEURISTIC && !g->has_lr)
         step = o->step * sl_flow_local_size(f, f->lo, NULL); /* constant on a regular field */
+    /* LR: u_step = H, the shader multiplies by its element's size per point */
     double h0 = o->step > 0.0 ? o->step : pow(o->tol, 1.0 / (double)(m->embedded_order + 1));
     if (m->embedded_order)
         h0 = h0 > h_max ? h_max : h0 < h_min ? h_min : h0;

@@ -6,16 +6,17 @@
  * Precision: single = float everywhere; mixed = double for positions,
  * time and the RK update, the field evaluated in float at local
  * coordinates (cell index and weights found in double, as the paper
- * evaluates in element-local coordinates; an LR field_m would do the same
- * per element); double = double everywhere, the trilinear included
- * (texel values are floats, converted exactly). Mixed and double need
+ * evaluates in element-local coordinates; an LR field_m does the same per
+ * element: element and local coordinates in double, de Casteljau in float);
+ * double = double everywhere, the trilinear and the Bézier evaluation
+ * included (texel values are floats, converted exactly). Mixed and double need
  * doubles in GLSL (core in 4.50, GL_ARB_gpu_shader_fp64; llvmpipe has them).
- * Regular vector fields only, as an RGBA32F 3D texture sampled by
- * texelFetch with the CPU's trilinear order of operations
- * (flow_field_regular.glsl). LR fields: SL_ERR_UNSUPPORTED "not yet" until
- * the Bézier evaluation (lrspline/lr_bezier.glsl) and the element look-up
- * (lr_lookup.glsl) are wired as a flow_field_lr.glsl defining
- * field()/field_d() and a flow_trace_lr.comp.glsl of three includes.
+ * Regular vector fields as an RGBA32F 3D texture sampled by texelFetch
+ * with the CPU's trilinear order of operations (flow_field_regular.glsl);
+ * LR-spline volumes of dim 3 as the Bézier blocks and element look-up of
+ * lrspline/sl_lr_bezier.h (flow_field_lr.glsl; SSBO bindings 6..12, flow's
+ * own 0..2), built from the model once in create; their heuristic step is
+ * per point (the element's min side / 2^degree, as sl_flow_local_size).
  * Render thread only, GL context current. Not done here: drawing (the
  * result goes through sl_flow_result_to_dataset to renderer/tubes).
  */
@@ -35,9 +36,11 @@ const char *sl_flow_precision_name(sl_flow_precision p);
 
 typedef struct sl_flow_gpu sl_flow_gpu;
 
-/* Uploads the field. SL_ERR_UNSUPPORTED for LR and analytic fields (the
- * message says which), SL_ERR_GPU on GL failure. The field's volume is
- * borrowed only during the call. */
+/* Uploads the field (LR: builds the Bézier blocks and the look-up, then
+ * uploads them). SL_ERR_UNSUPPORTED for analytic fields and LR models not
+ * of dim 3 (the message says which), the block build's errors
+ * (SL_ERR_NOMEM, SL_ERR_LIMIT), SL_ERR_GPU on GL failure. The field's
+ * volume or LR model is borrowed only during the call. */
 sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err);
 void sl_flow_gpu_destroy(sl_flow_gpu *g); /* NULL is fine */
 

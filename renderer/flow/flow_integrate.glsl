@@ -2,7 +2,7 @@
 // one invocation per streamline (sl_flow.h states the rules: step modes,
 // error control, boundary bisection and the Euler step to the face, stop
 // reasons). Expects REAL, VEC3, flow_finite3 (flow_real.glsl) and field()
-// / field_m() / field_d() before it. The tableau and the step mode are
+// / field_m() / field_d() / flow_local_size() before it. The tableau and the step mode are
 // uniforms (so one program per precision, and shaders-check compiles it
 // without defines). Difference from the CPU: the
 // step factor (tol/err)^(1/(q+1)) is root_n (float pow refined by Newton in
@@ -34,7 +34,9 @@ uniform REAL u_step, u_tol, u_h_min, u_h_max, u_t_max, u_min_speed, u_h0;
 // The Butcher tableau (sl_flow_methods): a row-major 6 x 6, b, and d = b - e
 // (subtracted in C), zero-padded; stages, embedded order (0: fixed step)
 // and step mode (0 fixed, 1 heuristic = fixed h = step * local size, a
-// constant on a regular field, 2 adaptive).
+// constant on a regular field (u_step holds the product, its
+// flow_local_size is 1), per point on an LR field (flow_local_size(x) the
+// element's; u_step holds H), 2 adaptive).
 #define SL_MAX_STAGES 6
 uniform REAL u_a[SL_MAX_STAGES * SL_MAX_STAGES];
 uniform REAL u_b[SL_MAX_STAGES];
@@ -162,6 +164,8 @@ int trace(out uint rejected, out uint forced)
         if (norm3(v) < u_min_speed)
             return STOP_STAGNANT;
         REAL h = u_mode == 2 ? h_adapt : u_step;
+        if (u_mode == 1) // the field's local size at x (regular: 1, u_step holds the product)
+            h = u_step * flow_local_size(x);
         REAL remaining = u_t_max - t;
         bool last = false;
         if (h >= remaining) {

@@ -44,3 +44,39 @@ sl_add_render_test(NAME flow.trace_seed_box_and_usage COMMAND ${CMAKE_COMMAND}
   "-DSTEP6=${FLOW_TRACE}|${FLOW_OUT}/b/helix.nrrd|--seeds|${FLOW_OUT}/b/seeds.csv|--solver|rk4|--tol|1e-6|--t-max|1|--out|${FLOW_OUT}/b/x.csv"
   -DEXIT6=1 "-DERR6=has a fixed step: give a step, not a tolerance"
   ${SL_STEPS})
+
+# sightline-trace --gpu on an LR-spline volume: tests/data/lr/refined_quadratic.lr.gz
+# (a file of the reference library: the identity map v(x) = x on [0,1]^3 as a
+# locally refined quadratic, 1240 elements, sides 1/16 .. 1/4), so the
+# streamlines are x0 e^t, exact. 8 box seeds, rk4 h = 0.02 until they leave
+# the box. CPU: within 1e-7 of x0 e^t (h^4 truncation; measured 1.1e-10 at
+# h = 0.01), ending on a face; GPU double = CPU to 1e-12 of the box (same
+# rows), mixed to 1e-7 (same rows); single against the exact solution to 1e-5
+# (its boundary bisection in float can drop one sample, so rows may differ).
+# Heuristic steps (H = 0.5 times the element's min side / 2^2) cross elements
+# of different sizes: CPU within 1e-7 of x0 e^t, GPU double = CPU to 1e-12,
+# mixed to 1e-7 (same rows, so the same step per element).
+set(FLOW_LR ${CMAKE_SOURCE_DIR}/tests/data/lr/refined_quadratic.lr.gz)
+set(FLOW_LR_ARGS ${FLOW_LR}|--seed-box|0.1,0.1,0.1,0.5,0.5,0.5,8|--solver|rk4|--step|0.02|--t-max|3)
+set(FLOW_LR_HEUR ${FLOW_LR}|--seed-box|0.1,0.1,0.1,0.5,0.5,0.5,8|--solver|rk4|--step|0.5|--heuristic|--t-max|3)
+file(MAKE_DIRECTORY ${FLOW_OUT}/lr)
+sl_add_render_test(NAME flow.trace_lr_gpu_matches_cpu COMMAND ${CMAKE_COMMAND}
+  "-DSTEP1=${FLOW_TRACE}|${FLOW_LR_ARGS}|--out|${FLOW_OUT}/lr/cpu.csv"
+  "-DOUT1=traced 8 lines, .*stops: boundary 8"
+  "-DSTEP2=${FLOW_CHECK}|verify-exp|${FLOW_OUT}/lr/cpu.csv|8|1e-7"
+  "-DSTEP3=${FLOW_TRACE}|${FLOW_LR_ARGS}|--gpu|--precision|double|--out|${FLOW_OUT}/lr/double.csv"
+  "-DOUT3=traced 8 lines, .*stops: boundary 8"
+  "-DSTEP4=${FLOW_CHECK}|compare|${FLOW_OUT}/lr/cpu.csv|${FLOW_OUT}/lr/double.csv|1e-12|1"
+  "-DSTEP5=${FLOW_TRACE}|${FLOW_LR_ARGS}|--gpu|--precision|mixed|--out|${FLOW_OUT}/lr/mixed.csv"
+  "-DSTEP6=${FLOW_CHECK}|compare|${FLOW_OUT}/lr/cpu.csv|${FLOW_OUT}/lr/mixed.csv|1e-7|1"
+  "-DSTEP7=${FLOW_TRACE}|${FLOW_LR_ARGS}|--gpu|--precision|single|--out|${FLOW_OUT}/lr/single.csv"
+  "-DSTEP8=${FLOW_CHECK}|verify-exp|${FLOW_OUT}/lr/single.csv|8|1e-5"
+  ${SL_STEPS})
+sl_add_render_test(NAME flow.trace_lr_gpu_heuristic COMMAND ${CMAKE_COMMAND}
+  "-DSTEP1=${FLOW_TRACE}|${FLOW_LR_HEUR}|--out|${FLOW_OUT}/lr/cpu_h.csv"
+  "-DSTEP2=${FLOW_CHECK}|verify-exp|${FLOW_OUT}/lr/cpu_h.csv|8|1e-7"
+  "-DSTEP3=${FLOW_TRACE}|${FLOW_LR_HEUR}|--gpu|--precision|double|--out|${FLOW_OUT}/lr/double_h.csv"
+  "-DSTEP4=${FLOW_CHECK}|compare|${FLOW_OUT}/lr/cpu_h.csv|${FLOW_OUT}/lr/double_h.csv|1e-12|1"
+  "-DSTEP5=${FLOW_TRACE}|${FLOW_LR_HEUR}|--gpu|--precision|mixed|--out|${FLOW_OUT}/lr/mixed_h.csv"
+  "-DSTEP6=${FLOW_CHECK}|compare|${FLOW_OUT}/lr/cpu_h.csv|${FLOW_OUT}/lr/mixed_h.csv|1e-7|1"
+  ${SL_STEPS})

@@ -14,7 +14,7 @@
  * double still part somewhere, cause not found), so each is checked against a fine
  * reference (RKF5, h = 1e-3, double) interpolated by cubic Hermite at its
  * own times: GPU error <= 2 x the CPU adaptive run's error + 1e-9 (double)
- * or + 1e-5 (single, mixed), and the same stop reasons. Also: the LR refusal, mixed/double
+ * or + 1e-5 (single, mixed), and the same stop reasons. Also: an LR field without a model of dim 3 is refused, mixed/double
  * programs compile, the GPU never hangs on a seed outside or NaN.
  */
 #include <math.h>
@@ -208,10 +208,11 @@ int main(void)
     } else {
         SL_CHECK_MSG(0, "degenerate seeds: %s", err.message);
     }
-    /* LR fields are refused with a sentence. */
+    /* An LR field without a model of dim 3 is refused with a sentence (LR
+     * fields themselves: test_flow_gpu_lr.c). */
     sl_flow_field lr = {.kind = SL_FLOW_FIELD_LR};
     sl_flow_gpu *none = NULL;
-    SL_CHECK(sl_flow_gpu_create(&lr, &none, &err) == SL_ERR_UNSUPPORTED && strstr(err.message, "not yet"));
+    SL_CHECK(sl_flow_gpu_create(&lr, &none, &err) == SL_ERR_UNSUPPORTED && strstr(err.message, "dim 3"));
     free(seeds);
     sl_flow_gpu_destroy(g);
     sl_dataset_destroy(ds);

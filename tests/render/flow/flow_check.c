@@ -7,8 +7,13 @@
  *       line,t,x,y,z,vx,vy,vz, lines 0..LINES-1 in order with times rising
  *       from 0 to T_MAX, every position within TOL of the exact helix from
  *       the line's first sample, every velocity = (-y, x, 0.5) to 1e-9.
- *   flow-check compare A.csv B.csv BOUND   same rows and line ids; max
- *       |x_a - x_b| / 4 (the box side) <= BOUND.
+ *   flow-check verify-exp L.csv LINES TOL   the identity field v(x) = x on
+ *       [0,1]^3 (tests/data/lr/refined_quadratic.lr.gz): lines 0..LINES-1,
+ *       times rising from 0, every position within TOL of the exact
+ *       x0 e^t, every velocity = its position to TOL, each line's last
+ *       sample on the face x_c = 1 of its largest coordinate (to TOL).
+ *   flow-check compare A.csv B.csv BOUND [SIDE]   same rows and line ids;
+ *       max |x_a - x_b| / SIDE (the box side, default 4) <= BOUND.
  * Exit 0 and "pass" on success, 1 and "check failed: ..." otherwise.
  */
 #include <math.h>
@@ -120,18 +125,62 @@ int main(int argc, char **argv)
         printf("pass\n");
         return 0;
     }
-    if (argc == 5 && strcmp(argv[1], "compare") == 0) {
+    if (argc == 5 && strcmp(argv[1], "verify-exp") == 0) {
+        size_t n;
+        int header;
+        csv_row *r = read_csv(argv[2], &n, &header);
+        long lines = atol(argv[3]);
+        double tol = atof(argv[4]), worst = 0;
+        if (!r || !header || n == 0)
+            return fail("missing rows or header line,t,x,y,z,vx,vy,vz");
+        long expect = 0;
+        size_t first = 0;
+        for (size_t i = 0; i <= n; i++) {
+            if (i == n || i == 0 || r[i].line != r[i - 1].line) {
+                if (i > 0) { /* the previous line ends on a face x_c = 1 */
+                    const double *x = r[i - 1].v + 1;
+                    double m = fmax(fmax(x[0], x[1]), x[2]);
+                    if (!(fabs(m - 1.0) <= tol))
+                        return fail("a line does not end on the face x_c = 1");
+                }
+                if (i == n)
+                    break;
+                if (r[i].line != expect++ || r[i].v[0] != 0)
+                    return fail("line ids not 0..N-1 in order, or a line not starting at t = 0");
+                first = i;
+            } else if (!(r[i].v[0] > r[i - 1].v[0])) {
+                return fail("times do not rise");
+            }
+            const double *s = r[first].v + 1, t = r[i].v[0], *x = r[i].v + 1, *v = r[i].v + 4;
+            for (int c = 0; c < 3; c++) {
+                worst = fmax(worst, fabs(s[c] * exp(t) - x[c]));
+                if (!(fabs(v[c] - x[c]) <= tol))
+                    return fail("a velocity is not the field (= the position) at its position");
+            }
+        }
+        free(r);
+        if (expect != lines)
+            return fail("wrong number of lines");
+        printf("max error against the exact x0 e^t %.3g (bound %g)\n", worst, tol);
+        if (!(worst <= tol))
+            return fail("error above the bound");
+        printf("pass\n");
+        return 0;
+    }
+    if ((argc == 5 || argc == 6) && strcmp(argv[1], "compare") == 0) {
         size_t na, nb;
         int ha, hb;
         csv_row *a = read_csv(argv[2], &na, &ha), *b = read_csv(argv[3], &nb, &hb);
-        double bound = atof(argv[4]), worst = 0;
+        double bound = atof(argv[4]), side = argc == 6 ? atof(argv[5]) : 4.0, worst = 0;
+        if (!(side > 0))
+            return fail("the box side must be positive");
         if (!a || !b || !ha || !hb || na != nb)
             return fail("the two files differ in rows or headers");
         for (size_t i = 0; i < na; i++) {
             if (a[i].line != b[i].line)
                 return fail("line ids differ");
             for (int c = 1; c < 4; c++)
-                worst = fmax(worst, fabs(a[i].v[c] - b[i].v[c]) / 4.0);
+                worst = fmax(worst, fabs(a[i].v[c] - b[i].v[c]) / side);
         }
         free(a);
         free(b);
@@ -141,6 +190,6 @@ int main(int argc, char **argv)
         printf("pass\n");
         return 0;
     }
-    fprintf(stderr, "usage: flow-check write-helix DIR | verify L.csv LINES T_MAX TOL | compare A B BOUND\n");
+    fprintf(stderr, "usage: flow-check write-helix DIR | verify L.csv LINES T_MAX TOL | verify-exp L.csv LINES TOL | compare A B BOUND [SIDE]\n");
     return 2;
 }
