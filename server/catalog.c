@@ -520,6 +520,26 @@ sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t 
     return st;
 }
 
+/* The rows of a named table (count_sql: "SELECT COUNT(*), SUM(name = ?1)
+ * FROM t") and whether `name` is among them: the caps of saved views and
+ * paths (a new name only below the cap, a replacement always). */
+static sl_status count_named(sqlite3 *db, const char *count_sql, const char *name, long long *count,
+                             int *exists, sl_err *err)
+{
+    sqlite3_stmt *q = NULL;
+    *count = 0;
+    *exists = 0;
+    if (sqlite3_prepare_v2(db, count_sql, -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare count");
+    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(q) == SQLITE_ROW) {
+        *count = sqlite3_column_int64(q, 0);
+        *exists = sqlite3_column_int64(q, 1) > 0;
+    }
+    sqlite3_finalize(q);
+    return SL_OK;
+}
+
 sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *dataset, const char *technique,
                                const char *params_json, const char *camera_json, sl_err *err)
 {
@@ -527,15 +547,9 @@ sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *datase
     /* Replacing a view is always allowed; a new name only below the cap. */
     long long count = 0;
     int exists = 0;
-    if (sqlite3_prepare_v2(db, "SELECT COUNT(*), SUM(name = ?1) FROM views", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare count views");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(q) == SQLITE_ROW) {
-        count = sqlite3_column_int64(q, 0);
-        exists = sqlite3_column_int64(q, 1) > 0;
-    }
-    sqlite3_finalize(q);
-    q = NULL;
+    sl_status cst = count_named(db, "SELECT COUNT(*), SUM(name = ?1) FROM views", name, &count, &exists, err);
+    if (cst != SL_OK)
+        return cst;
     if (!exists && count >= SL_CATALOG_MAX_VIEWS)
         return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved views (the limit); reuse a name",
                           SL_CATALOG_MAX_VIEWS);
@@ -605,15 +619,9 @@ sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *techni
     sqlite3_stmt *q = NULL;
     long long count = 0;
     int exists = 0;
-    if (sqlite3_prepare_v2(db, "SELECT COUNT(*), SUM(name = ?1) FROM paths", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare count paths");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(q) == SQLITE_ROW) {
-        count = sqlite3_column_int64(q, 0);
-        exists = sqlite3_column_int64(q, 1) > 0;
-    }
-    sqlite3_finalize(q);
-    q = NULL;
+    sl_status cst = count_named(db, "SELECT COUNT(*), SUM(name = ?1) FROM paths", name, &count, &exists, err);
+    if (cst != SL_OK)
+        return cst;
     if (!exists && count >= SL_CATALOG_MAX_PATHS)
         return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved paths (the limit); reuse a name",
                           SL_CATALOG_MAX_PATHS);
