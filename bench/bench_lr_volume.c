@@ -4,16 +4,19 @@
  *   bench-lr-volume [--small | --size WxH] [--frames N] [--error-size WxH]
  *
  * Dataset: lr_field sphere, degree 2, 6 cells, grading 0.6 (element sides
- * varying 4x; 216 elements, within what the placeholder linear element
- * look-up can do on llvmpipe). Fixed transfer function (points form),
+ * varying 4x; 216 elements; k-d forest look-up). Fixed transfer function (points form),
  * no shading, orbit 30/20/2.5. Error: frame 0's camera at --error-size
  * (default 160x90), mean and max |ΔRGB| (0..255, every channel) against
  * lr_volume itself at uniform step 1/32 of the smallest side (the converged
  * integral: the field is evaluated exactly, only the quadrature differs).
  * Time: the harness's wall ms per frame (orbit of N frames after a warm-up)
  * at the bench size (default 1280x720), with the samples of frame 0.
- * Slow at 1280x720 on llvmpipe with the placeholder look-up (a linear scan
- * per element change); --small for a quick table.
+ * Peer (second table): the same field both ways — lr_field trilinear_ml
+ * (degree 1, knots at the voxel centres: exactly the trilinear interpolant)
+ * through lr_volume, and the marschner_lobb voxels through volume_dvr (what a
+ * user would otherwise pick), same camera, transfer function and step of
+ * half a voxel (no jitter, no shading); ms per frame, their ratio and the
+ * images' difference. --small for a quick table.
  * Prints Markdown; checks nothing (tests/unit/test_lr_volume.c does).
  */
 #include <stdio.h>
@@ -59,6 +62,70 @@ static sl_status render_into(sl_pipeline *p, const sl_technique *t, const sl_par
             sl_pipeline_read_rgba(p, rgba, 1);
         *samples = fs.render.samples;
     }
+    return st;
+}
+
+/* lr_volume on the spline that equals the marschner_lobb volume's trilinear
+ * interpolant against volume_dvr on the voxels: same view, TF and step. */
+static sl_status peer_table(sl_gpu *gpu, const sl_bench_options *bo, int ew, int eh, sl_err *err)
+{
+    static const char *const TF = "{\"transfer_function\":[[0,0,0,0,0],[0.3,1,0.5,0.2,0.05],[0.6,0.2,0.6,1,0.3],"
+                                  "[1,1,1,1,0.8]],\"shading\":false";
+    static const struct { const char *technique, *dataset, *extra; } sides[2] = {
+        {"lr_volume", "{\"generator\":\"lr_field\",\"field\":\"trilinear_ml\",\"degree\":1,\"cells\":40}",
+         ",\"step_mode\":\"uniform\",\"step\":0.5}"},
+        {"volume_dvr", "{\"generator\":\"marschner_lobb\",\"size\":41}", ",\"step\":0.5,\"jitter\":false}"},
+    };
+    size_t n = (size_t)ew * eh;
+    uint8_t *img[2] = {malloc(4 * n), malloc(4 * n)};
+    double ms[2] = {0, 0}, samples[2] = {0, 0};
+    sl_status st = img[0] && img[1] ? SL_OK : sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    for (int k = 0; k < 2 && st == SL_OK; k++) {
+        sl_pipeline *p = NULL;
+        sl_dataset *ds = NULL;
+        const sl_technique *t = sl_technique_find(sides[k].technique);
+        if ((st = sl_pipeline_create(gpu, &p, err)) != SL_OK)
+            break;
+        if ((st = sl_generate_json(sides[k].dataset, &ds, err)) == SL_OK) {
+            sl_pipeline_set_dataset(p, ds);
+            ds = (sl_dataset *)sl_pipeline_dataset(p);
+            sl_params q;
+            sl_params_init(&q, t->params, t->param_count);
+            char json[512];
+            snprintf(json, sizeof json, "%s%s", TF, sides[k].extra);
+            cJSON *patch = cJSON_Parse(json);
+            st = patch ? sl_params_apply_json(&q, patch, err) : sl_err_set(err, SL_ERR_INVALID, "bad peer JSON");
+            cJSON_Delete(patch);
+            sl_view ev;
+            sl_bench_timing tm;
+            if (st == SL_OK && (st = view_at(ds, ew, eh, &ev, err)) == SL_OK &&
+                (st = render_into(p, t, &q, &ev, img[k], &samples[k], err)) == SL_OK &&
+                (st = sl_bench_time_frames(p, t, &q, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit, &tm,
+                                           err)) == SL_OK)
+                ms[k] = tm.median_ms;
+        }
+        sl_pipeline_destroy(p);
+    }
+    if (st == SL_OK) {
+        double sum = 0;
+        int mx = 0;
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                int e = abs((int)img[0][4 * i + c] - (int)img[1][4 * i + c]);
+                sum += e;
+                mx = e > mx ? e : mx;
+            }
+        printf("\n## Peer: lr_volume on the trilinear-equivalent spline vs volume_dvr on the voxels\n\n"
+               "marschner_lobb 41^3 both ways (lr_field trilinear_ml, 64000 elements), step 0.5 voxel, "
+               "time at %dx%d, median of %d frames; images compared at %dx%d\n\n"
+               "| technique | samples (error frame) | ms / frame |\n|---|---|---|\n"
+               "| lr_volume | %.0f | %.1f |\n| volume_dvr | %.0f | %.1f |\n\n"
+               "ratio lr_volume / volume_dvr: %.2f; images: mean dRGB %.3f, max %d\n",
+               bo->width, bo->height, bo->frames, ew, eh, samples[0], ms[0], samples[1], ms[1],
+               ms[1] > 0 ? ms[0] / ms[1] : 0.0, sum / (3.0 * n), mx);
+    }
+    free(img[0]);
+    free(img[1]);
     return st;
 }
 
@@ -153,6 +220,8 @@ int main(int argc, char **argv)
         printf("| %s | %.0f | %.3f | %d | %.1f |\n", label, samples, sum / (3.0 * n), mx, tm.median_ms);
         fflush(stdout);
     }
+    if (st == SL_OK)
+        st = peer_table(gpu, &bo, ew, eh, &err);
     if (st != SL_OK)
         fprintf(stderr, "bench-lr-volume: %s\n", err.message);
     free(ref);
