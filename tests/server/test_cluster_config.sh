@@ -5,7 +5,7 @@
 # HAProxy must accept both that file and the loopback layout scripts/cluster starts.
 # Each compose node must run with the node id and agent port HAProxy expects, and
 # reach the catalog the postgres service holds. Containers cannot run here; this
-# checks the files, not a running cluster (tests/server/test_cluster.c does that).
+# checks the files, not a running cluster (tests/server/test_server_cluster.c does that).
 # Prints "N passed, N failed".
 set -uo pipefail
 root="${SIGHTLINE_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"

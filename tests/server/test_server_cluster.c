@@ -1,0 +1,502 @@
+/* test_server_cluster.c — three render nodes behind HAProxy on one PostgreSQL catalog,
+ * all started by this test (scripts/pg-temp, then scripts/cluster), loopback only.
+ *
+ *  1. 30 new sessions through the balancer spread over all three nodes (each
+ *     gets at least 5), and every session id starts with the node that says
+ *     `welcome.node`;
+ *  2. collaborators join through the balancer with a share link
+ *     (/ws?session=ID, hello with id + token): each lands on the session's node
+ *     and, after a camera move, gets the same frame id as the creator;
+ *  3. a view saved on one node loads on another (the shared catalog);
+ *  4. a wrong token, and a token of another session (replayed), are refused
+ *     with bad_token through the balancer and on every node directly;
+ *  5. a node killed with SIGKILL: every one of its sessions, rejoined through
+ *     the balancer as the page does, comes back on another node with the same
+ *     camera and a frame within 10 s of the kill;
+ *  6. a node sent SIGTERM drains: its /healthz answers 503, new sessions go
+ *     only to the others, its own client still gets frames, and it exits when
+ *     that last client leaves.
+ * Bounded: every wait has a deadline; the cluster and PostgreSQL are stopped
+ * (and their directories removed) on every path out.
+ */
+#include <sys/types.h>
+
+#include "sl_server_harness.h"
+
+#define NODES 3
+#define NEW_SESSIONS 30
+#define SIZE 64
+
+static int failures;
+#define CHECK(cond, ...)                                                   \
+    do {                                                                   \
+        if (!(cond)) {                                                     \
+            failures++;                                                    \
+            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);           \
+            fprintf(stderr, __VA_ARGS__);                                  \
+            fputc('\n', stderr);                                           \
+        }                                                                  \
+    } while (0)
+
+typedef struct cluster {
+    char dir[64];           /* /tmp/sl-cluster-test-XXXXXX */
+    char db[256];           /* postgresql://... */
+    pid_t script;           /* scripts/cluster */
+    FILE *out;              /* its stdout */
+    int port;               /* HAProxy */
+    pid_t node_pid[NODES];
+    int node_port[NODES];
+} cluster;
+
+static const char *src_dir(void)
+{
+    const char *s = getenv("SIGHTLINE_SOURCE_DIR");
+    return s ? s : ".";
+}
+
+static const char *bin_dir(void)
+{
+    const char *b = getenv("SIGHTLINE_BINARY_DIR");
+    return b ? b : "build";
+}
+
+/* A free loopback TCP port (bound, read, closed). */
+static int free_port(void)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    socklen_t len = sizeof a;
+    int port = -1;
+    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 && getsockname(fd, (struct sockaddr *)&a, &len) == 0)
+        port = ntohs(a.sin_port);
+    if (fd >= 0)
+        close(fd);
+    return port;
+}
+
+/* Runs a shell command line and keeps the first line of its stdout. */
+static int run_capture(const char *cmd, char *out, size_t size)
+{
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    out[0] = 0;
+    if (!fgets(out, (int)size, p))
+        out[0] = 0;
+    char sink[256];
+    while (fgets(sink, sizeof sink, p))
+        ;
+    int st = pclose(p);
+    out[strcspn(out, "\n")] = 0;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* 1 while pid runs (a zombie child of the cluster script counts as gone). */
+static int process_alive(pid_t pid)
+{
+    char path[64], stat[256] = "";
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    size_t n = fread(stat, 1, sizeof stat - 1, f);
+    fclose(f);
+    stat[n] = 0;
+    const char *paren = strrchr(stat, ')');
+    return paren && paren[1] == ' ' && paren[2] != 'Z' && paren[2] != 'X';
+}
+
+static int cluster_start(cluster *c)
+{
+    memset(c, 0, sizeof *c);
+    c->script = -1;
+    snprintf(c->dir, sizeof c->dir, "/tmp/sl-cluster-test-XXXXXX");
+    if (!mkdtemp(c->dir))
+        return -1;
+    chmod(c->dir, 0755); /* the throwaway PostgreSQL runs as another user when we are root */
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "bash '%s/scripts/pg-temp' start '%s/pg'", src_dir(), c->dir);
+    if (run_capture(cmd, c->db, sizeof c->db) != 0 || strncmp(c->db, "postgresql://", 13) != 0) {
+        fprintf(stderr, "cluster: PostgreSQL did not start (%s)\n", c->db);
+        return -1;
+    }
+    char sink[256];
+    snprintf(cmd, sizeof cmd, "'%s/bin/sightline-server' --db '%s' catalog add-generator tiny '%s' 2>&1", bin_dir(),
+             c->db, HARNESS_TINY);
+    if (run_capture(cmd, sink, sizeof sink) != 0) {
+        fprintf(stderr, "cluster: could not register the dataset: %s\n", sink);
+        return -1;
+    }
+    c->port = free_port();
+    int base = free_port();
+    if (c->port <= 0 || base <= 0 || base > 60000)
+        return -1;
+    base = base - base % 100; /* node ports base+i, agents base+100+i */
+    int fds[2];
+    if (pipe(fds) != 0)
+        return -1;
+    c->script = fork();
+    if (c->script == 0) {
+        dup2(fds[1], 1);
+        close(fds[0]);
+        close(fds[1]);
+        setpgid(0, 0);
+        char script[512], build[512], portv[16], basev[16];
+        snprintf(script, sizeof script, "%s/scripts/cluster", src_dir());
+        snprintf(build, sizeof build, "%s", bin_dir());
+        snprintf(portv, sizeof portv, "%d", c->port);
+        snprintf(basev, sizeof basev, "%d", base);
+        char *argv[] = {"bash", script, "--nodes", "3", "--port", portv, "--base-port", basev, "--db", c->db,
+                        "--build", build, "--data-dir", c->dir, "--", "--default-dataset", "tiny",
+                        "--max-pending", "64", "--max-clients", "128", "--max-sessions", "64", "--grace", "20",
+                        NULL};
+        execvp("bash", argv);
+        _exit(127);
+    }
+    close(fds[1]);
+    c->out = fdopen(fds[0], "r");
+    if (c->script < 0 || !c->out)
+        return -1;
+    /* Read the script's lines until "cluster: open" (bounded: the script waits for each node). */
+    char line[512];
+    int nodes_seen = 0;
+    double deadline = sl_clock_ms() + 120000;
+    while (sl_clock_ms() < deadline) {
+        struct pollfd pfd = {.fd = fds[0], .events = POLLIN};
+        if (poll(&pfd, 1, 500) <= 0)
+            continue;
+        if (!fgets(line, sizeof line, c->out))
+            break;
+        fputs(line, stderr);
+        int i, pid, port, agent;
+        if (sscanf(line, "cluster: node%d pid %d port %d agent %d", &i, &pid, &port, &agent) == 4 && i >= 1 &&
+            i <= NODES) {
+            c->node_pid[i - 1] = pid;
+            c->node_port[i - 1] = port;
+            nodes_seen++;
+        }
+        if (strncmp(line, "cluster: open", 13) == 0)
+            return nodes_seen == NODES ? 0 : -1;
+    }
+    fprintf(stderr, "cluster: scripts/cluster did not come up\n");
+    return -1;
+}
+
+static void cluster_stop(cluster *c)
+{
+    if (c->script > 0) {
+        kill(c->script, SIGTERM);
+        double deadline = sl_clock_ms() + 30000;
+        int status = 0;
+        while (waitpid(c->script, &status, WNOHANG) == 0 && sl_clock_ms() < deadline)
+            usleep(100000);
+        if (waitpid(c->script, &status, WNOHANG) == 0) {
+            kill(-c->script, SIGKILL);
+            waitpid(c->script, &status, 0);
+        }
+    }
+    if (c->out)
+        fclose(c->out);
+    char cmd[512], sink[64];
+    if (c->db[0]) {
+        snprintf(cmd, sizeof cmd, "bash '%s/scripts/pg-temp' stop '%s/pg'", src_dir(), c->dir);
+        run_capture(cmd, sink, sizeof sink);
+    }
+    if (strncmp(c->dir, "/tmp/sl-cluster-test-", 21) == 0) {
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->dir);
+        if (system(cmd) != 0)
+            fprintf(stderr, "cluster: could not remove %s\n", c->dir);
+    }
+}
+
+/* A client through `port` with /ws?session=ID when it joins, as the page connects. */
+static int connect_as_page(tclient *t, int port, const char *session)
+{
+    memset(t, 0, sizeof *t);
+    char path[160] = "/ws";
+    if (session)
+        snprintf(path, sizeof path, "/ws?session=%s", session);
+    return sl_wsclient_connect("127.0.0.1", port, path, SL_PROTO_SUBPROTOCOL, NULL, 10000, &t->ws, &t->err) == SL_OK
+               ? 0 : -1;
+}
+
+static const char *welcome_node(const tclient *t)
+{
+    const cJSON *n = cJSON_GetObjectItemCaseSensitive(t->welcome, "node");
+    return cJSON_IsString(n) ? n->valuestring : "";
+}
+
+static int node_index(const char *node)
+{
+    int i = 0;
+    return sscanf(node, "node%d", &i) == 1 && i >= 1 && i <= NODES ? i - 1 : -1;
+}
+
+static double welcome_azimuth(const tclient *t)
+{
+    const cJSON *st = cJSON_GetObjectItemCaseSensitive(t->welcome, "state");
+    const cJSON *orbit = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "camera"), "orbit");
+    const cJSON *az = cJSON_GetObjectItemCaseSensitive(orbit, "azimuth");
+    return cJSON_IsNumber(az) ? az->valuedouble : NAN;
+}
+
+static int send_orbit(tclient *t, uint32_t seq, double azimuth)
+{
+    return tclient_send(t, "{\"type\":\"camera\",\"seq\":%u,\"camera\":{\"orbit\":{\"azimuth\":%.3f,"
+                           "\"elevation\":20,\"distance\":2.5}}}", seq, azimuth);
+}
+
+/* The error code a hello gets (NULL on a welcome or no answer); code has 64 bytes. */
+static const char *hello_error(int port, const char *session, const char *token, char code[64])
+{
+    tclient t;
+    code[0] = 0;
+    if (connect_as_page(&t, port, session) != 0)
+        return NULL;
+    tclient_send(&t, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\",\"width\":%d,\"height\":%d}",
+                 session, token, SIZE, SIZE);
+    double deadline = sl_clock_ms() + 10000;
+    while (!code[0] && sl_clock_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(&t, 2000, &j);
+        if (r == 1 && strcmp(json_type(j), "error") == 0) {
+            const cJSON *cd = cJSON_GetObjectItemCaseSensitive(j, "code");
+            snprintf(code, 64, "%s", cJSON_IsString(cd) ? cd->valuestring : "?");
+        } else if (r == 1 && strcmp(json_type(j), "welcome") == 0) {
+            snprintf(code, 64, "welcome");
+        }
+        cJSON_Delete(j);
+        if (r < 0)
+            break;
+    }
+    tclient_close(&t);
+    return code[0] ? code : NULL;
+}
+
+int main(void)
+{
+    harness_small_asan_quarantine();
+    signal(SIGPIPE, SIG_IGN);
+    cluster cl;
+    if (cluster_start(&cl) != 0) {
+        cluster_stop(&cl);
+        fprintf(stderr, "FAIL: the cluster did not start\n");
+        return 1;
+    }
+
+    /* 1. New sessions spread over the nodes. */
+    static tclient s[NEW_SESSIONS];
+    int owner[NEW_SESSIONS], per_node[NODES] = {0};
+    uint32_t seq[NEW_SESSIONS];
+    double az_now[NEW_SESSIONS]; /* the camera each session shows (what a restore must bring back) */
+    for (int i = 0; i < NEW_SESSIONS; i++) {
+        owner[i] = -1;
+        seq[i] = 0;
+        az_now[i] = NAN;
+        if (connect_as_page(&s[i], cl.port, NULL) != 0 || tclient_hello(&s[i], NULL, NULL, SIZE, SIZE) != 0) {
+            CHECK(0, "session %d: no welcome through the balancer (%s)", i, s[i].err.message);
+            continue;
+        }
+        s[i].auto_ack = 1;
+        owner[i] = node_index(welcome_node(&s[i]));
+        char prefix[48];
+        snprintf(prefix, sizeof prefix, "%s.", welcome_node(&s[i]));
+        CHECK(owner[i] >= 0, "session %d: welcome.node '%s' is not one of the cluster's", i, welcome_node(&s[i]));
+        CHECK(strncmp(s[i].session, prefix, strlen(prefix)) == 0, "session id %s does not start with %s", s[i].session,
+              prefix);
+        if (owner[i] >= 0)
+            per_node[owner[i]]++;
+    }
+    fprintf(stderr, "sessions per node: %d %d %d\n", per_node[0], per_node[1], per_node[2]);
+    for (int n = 0; n < NODES; n++)
+        CHECK(per_node[n] >= 5, "node%d got %d of %d new sessions", n + 1, per_node[n], NEW_SESSIONS);
+    /* Every session shows a distinct camera, checkpointed at its still frame. */
+    for (int i = 0; i < NEW_SESSIONS; i++)
+        if (owner[i] >= 0) {
+            send_orbit(&s[i], ++seq[i], az_now[i] = 5.0 + 7.0 * i);
+            CHECK(tclient_wait_frame(&s[i], seq[i], 1, 60000) == 0, "session %d: no still frame for its camera", i);
+        }
+
+    /* 2. Collaborators land on the session's node and see the same frames. */
+    for (int n = 0; n < NODES; n++) {
+        int joined = 0;
+        for (int i = 0; i < NEW_SESSIONS && joined < 2; i++) {
+            if (owner[i] != n)
+                continue;
+            joined++;
+            tclient b;
+            if (connect_as_page(&b, cl.port, s[i].session) != 0 || tclient_hello(&b, s[i].session, s[i].token, SIZE, SIZE)) {
+                CHECK(0, "collaborator of %s: no welcome", s[i].session);
+                tclient_close(&b);
+                continue;
+            }
+            b.auto_ack = 1;
+            CHECK(strcmp(welcome_node(&b), welcome_node(&s[i])) == 0, "collaborator of %s landed on %s", s[i].session,
+                  welcome_node(&b));
+            send_orbit(&s[i], ++seq[i], az_now[i] = 11.0 + 7.0 * i);
+            int ok_a = tclient_wait_frame(&s[i], seq[i], 1, 30000) == 0;
+            int ok_b = tclient_wait_frame(&b, seq[i], 1, 30000) == 0;
+            CHECK(ok_a && ok_b, "collaborator of %s: the still frame of camera %u did not reach both", s[i].session,
+                  seq[i]);
+            if (ok_a && ok_b)
+                CHECK(s[i].last.h.frame_id == b.last.h.frame_id, "%s: creator frame %u, collaborator frame %u",
+                      s[i].session, s[i].last.h.frame_id, b.last.h.frame_id);
+            tclient_close(&b);
+        }
+    }
+
+    /* 3. A view saved on one node loads on another. */
+    int a = -1, bidx = -1;
+    for (int i = 0; i < NEW_SESSIONS; i++) {
+        if (owner[i] == 0 && a < 0)
+            a = i;
+        if (owner[i] == 1 && bidx < 0)
+            bidx = i;
+    }
+    if (a >= 0 && bidx >= 0) {
+        send_orbit(&s[a], ++seq[a], az_now[a] = 123.0);
+        tclient_wait_frame(&s[a], seq[a], 1, 30000);
+        tclient_send(&s[a], "{\"type\":\"save_view\",\"name\":\"cluster-view\"}");
+        cJSON *saved = tclient_wait_type(&s[a], "view_saved", 10000);
+        CHECK(saved != NULL, "save_view on node1 got no view_saved");
+        cJSON_Delete(saved);
+        tclient_send(&s[bidx], "{\"type\":\"load_view\",\"name\":\"cluster-view\"}");
+        double az = NAN, deadline = sl_clock_ms() + 10000;
+        while (isnan(az) && sl_clock_ms() < deadline) {
+            cJSON *j = NULL;
+            if (tclient_next(&s[bidx], 1000, &j) == 1 && strcmp(json_type(j), "state") == 0) {
+                const cJSON *orbit = cJSON_GetObjectItemCaseSensitive(
+                    cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(j, "patch"), "camera"), "orbit");
+                const cJSON *v = cJSON_GetObjectItemCaseSensitive(orbit, "azimuth");
+                if (cJSON_IsNumber(v))
+                    az = v->valuedouble;
+            }
+            cJSON_Delete(j);
+        }
+        CHECK(fabs(az - 123.0) < 1e-6, "the view saved on node1 loaded on node2 with azimuth %g, not 123", az);
+        az_now[bidx] = 123.0;
+        tclient_wait_frame(&s[bidx], 0, 1, 30000); /* its still frame (and checkpoint) */
+    } else {
+        CHECK(0, "no sessions on node1 and node2 to test saved views");
+    }
+
+    /* 4. Wrong and replayed tokens, through the balancer and on every node. */
+    char code[64];
+    for (int n = 0; n < NODES; n++) {
+        int i = -1, other = -1;
+        for (int k = 0; k < NEW_SESSIONS; k++) {
+            if (owner[k] == n && i < 0)
+                i = k;
+            else if (owner[k] >= 0 && owner[k] != n && other < 0)
+                other = k;
+        }
+        if (i < 0 || other < 0)
+            continue;
+        const char *e = hello_error(cl.port, s[i].session, "00000000000000000000000000000000", code);
+        CHECK(e && strcmp(e, "bad_token") == 0, "wrong token for %s through the balancer: %s", s[i].session, e ? e : "none");
+        e = hello_error(cl.port, s[i].session, s[other].token, code);
+        CHECK(e && strcmp(e, "bad_token") == 0, "replayed token for %s through the balancer: %s", s[i].session,
+              e ? e : "none");
+        for (int m = 0; m < NODES; m++) {
+            e = hello_error(cl.node_port[m], s[i].session, s[other].token, code);
+            CHECK(e && strcmp(e, "bad_token") == 0, "replayed token for %s on node%d directly: %s", s[i].session, m + 1,
+                  e ? e : "none");
+        }
+    }
+
+    /* 5. Kill node2: its sessions come back elsewhere with their cameras. */
+    const int dead = 1;
+    double kill_ms = sl_clock_ms();
+    kill(cl.node_pid[dead], SIGKILL);
+    double worst_ms = 0;
+    int restored = 0;
+    for (int i = 0; i < NEW_SESSIONS; i++) {
+        if (owner[i] != dead)
+            continue;
+        double expect = az_now[i];
+        tclient_close(&s[i]);
+        char session[64], token[64];
+        snprintf(session, sizeof session, "%s", s[i].session);
+        snprintf(token, sizeof token, "%s", s[i].token);
+        int back = 0;
+        while (!back && sl_clock_ms() - kill_ms < 15000) {
+            tclient t;
+            if (connect_as_page(&t, cl.port, session) == 0 && tclient_hello(&t, session, token, SIZE, SIZE) == 0) {
+                t.auto_ack = 1;
+                CHECK(node_index(welcome_node(&t)) != dead && node_index(welcome_node(&t)) >= 0,
+                      "%s came back on '%s'", session, welcome_node(&t));
+                double az = welcome_azimuth(&t);
+                CHECK(fabs(az - expect) < 1e-6, "%s came back with azimuth %g, not %g", session, az, expect);
+                CHECK(strcmp(t.session, session) == 0, "%s came back as %s", session, t.session);
+                if (tclient_wait_frame(&t, 0, 1, 10000) == 0) {
+                    back = 1;
+                    double ms = sl_clock_ms() - kill_ms;
+                    worst_ms = ms > worst_ms ? ms : worst_ms;
+                    restored++;
+                }
+                owner[i] = node_index(welcome_node(&t));
+                s[i] = t; /* keep it connected: it is a session of a live node now */
+                snprintf(s[i].session, sizeof s[i].session, "%s", session);
+                snprintf(s[i].token, sizeof s[i].token, "%s", token);
+            } else {
+                tclient_close(&t);
+                usleep(200000);
+            }
+        }
+        CHECK(back, "%s did not come back within 15 s of its node's death", session);
+    }
+    fprintf(stderr, "node2 killed: %d sessions back, the last after %.0f ms\n", restored, worst_ms);
+    CHECK(restored == per_node[dead], "%d of node2's %d sessions came back", restored, per_node[dead]);
+    CHECK(worst_ms <= 10000, "the last session came back after %.0f ms (limit 10 s)", worst_ms);
+
+    /* 6. Drain node3. */
+    const int drain = 2;
+    kill(cl.node_pid[drain], SIGTERM);
+    char body[2048];
+    int status = -1;
+    double deadline = sl_clock_ms() + 5000;
+    while ((status = harness_http_get(cl.node_port[drain], NULL, "/healthz", body, sizeof body)) != 503 &&
+           sl_clock_ms() < deadline)
+        usleep(100000);
+    CHECK(status == 503, "a draining node's /healthz answered %d, not 503", status);
+    usleep(2500000); /* HAProxy's agent asks every second */
+    int on_drain = 0, opened = 0;
+    tclient fresh[6];
+    for (int i = 0; i < 6; i++) {
+        if (connect_as_page(&fresh[i], cl.port, NULL) == 0 && tclient_hello(&fresh[i], NULL, NULL, SIZE, SIZE) == 0) {
+            opened++;
+            on_drain += node_index(welcome_node(&fresh[i])) == drain;
+        }
+    }
+    CHECK(opened == 6 && on_drain == 0, "while node3 drains: %d of 6 new sessions opened, %d on node3", opened, on_drain);
+    for (int i = 0; i < 6; i++)
+        tclient_close(&fresh[i]);
+    int drain_clients = 0;
+    for (int i = 0; i < NEW_SESSIONS; i++)
+        if (owner[i] == drain && s[i].ws) {
+            drain_clients++;
+            send_orbit(&s[i], ++seq[i], az_now[i] = 200.0 + i);
+            CHECK(tclient_wait_frame(&s[i], seq[i], 1, 30000) == 0, "%s on the draining node got no frame",
+                  s[i].session);
+        }
+    CHECK(drain_clients > 0, "node3 had no session to drain");
+    CHECK(process_alive(cl.node_pid[drain]), "node3 exited while it still had clients");
+    for (int i = 0; i < NEW_SESSIONS; i++)
+        if (owner[i] == drain)
+            tclient_close(&s[i]);
+    deadline = sl_clock_ms() + 20000;
+    while (process_alive(cl.node_pid[drain]) && sl_clock_ms() < deadline)
+        usleep(100000);
+    CHECK(!process_alive(cl.node_pid[drain]), "node3 did not exit within 20 s of its last client leaving");
+
+    for (int i = 0; i < NEW_SESSIONS; i++)
+        if (s[i].ws)
+            tclient_close(&s[i]);
+    cluster_stop(&cl);
+    if (failures)
+        fprintf(stderr, "%d check(s) failed\n", failures);
+    else
+        fprintf(stderr, "all checks passed\n");
+    return failures ? 1 : 0;
+}
