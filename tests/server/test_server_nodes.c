@@ -11,7 +11,8 @@
  *      checkpointed (its row names node-A, holds the camera and only the
  *      SHA-256 of the token); after SIGKILL of A, a hello on B with the same
  *      id and token restores it: same id, node-B in welcome, same camera,
- *      dataset and size, a frame arrives, and the row now names node-B; a
+ *      dataset and size, a frame arrives, and the row now names node-B (the
+ *      upgrade on /ws?session=ID, the page's form, is accepted); a
  *      second checkpointed session of A refuses a wrong token on B
  *      (bad_token) and a made-up id is unknown_session;
  *  (d) SIGTERM on C with one client connected: /healthz 503 "draining",
@@ -245,8 +246,12 @@ int main(void)
     tclient_close(&x);
     tclient_close(&y);
 
-    tclient r;
-    SL_CHECK(tclient_connect(&r, b.port, NULL) == 0);
+    tclient r; /* the page's URL form: the session id in the query, for a balancer; the server ignores it */
+    memset(&r, 0, sizeof r);
+    char ws_path[128];
+    snprintf(ws_path, sizeof ws_path, "/ws?session=%s", sid);
+    SL_CHECK_MSG(sl_wsclient_connect("127.0.0.1", b.port, ws_path, SL_PROTO_SUBPROTOCOL, NULL, 10000, &r.ws, &r.err) ==
+                 SL_OK, "upgrade on %s: %s", ws_path, r.err.message);
     SL_CHECK(tclient_hello(&r, sid, tok, W, H) == 0);
     SL_CHECK_MSG(strcmp(r.session, sid) == 0 && strcmp(r.token, tok) == 0, "restored as %s", r.session);
     node = welcome_string(&r, "node");
