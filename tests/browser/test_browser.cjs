@@ -953,8 +953,9 @@ async function main() {
     await obs.close();
 
     // 5. Server restart: a clear disconnect message, then automatic reconnect and frames again.
+    // SIGINT stops at once (SIGTERM would drain: serve the connected page until it leaves).
     const framesBefore = await page.evaluate(() => window.sightline.frames);
-    proc.kill('SIGTERM');
+    proc.kill('SIGINT');
     await new Promise((r) => { proc.on('exit', r); setTimeout(r, 15000); });
     await page.waitForFunction(() => !document.getElementById('banner').hidden &&
       /Disconnected/.test(document.getElementById('banner').textContent), null, { timeout: T });
@@ -966,7 +967,7 @@ async function main() {
     console.error(`browser test aborted: ${e.stack || e}`);
   } finally {
     await browser.close();
-    proc.kill('SIGTERM');
+    proc.kill('SIGINT');
     await new Promise((r) => { proc.on('exit', r); setTimeout(r, 15000); });
     fs.rmSync(dir, { recursive: true, force: true });
   }
