@@ -69,6 +69,31 @@ static int get_string(const cJSON *root, const char *key, char *out, size_t size
     return 1;
 }
 
+int sl_node_id_valid(const char *s)
+{
+    size_t n = 0;
+    for (; s[n]; n++)
+        if (n >= SL_NODE_ID_MAX ||
+            !((s[n] >= 'a' && s[n] <= 'z') || (s[n] >= 'A' && s[n] <= 'Z') || (s[n] >= '0' && s[n] <= '9') ||
+              s[n] == '_' || s[n] == '-'))
+            return 0;
+    return n > 0;
+}
+
+int sl_session_id_valid(const char *s)
+{
+    const char *dot = strrchr(s, '.');
+    if (!dot || (size_t)(dot - s) > SL_NODE_ID_MAX || strlen(dot + 1) != SL_SESSION_HEX)
+        return 0;
+    char node[SL_NODE_ID_MAX + 1];
+    memcpy(node, s, (size_t)(dot - s));
+    node[dot - s] = '\0';
+    for (const char *p = dot + 1; *p; p++)
+        if (!((*p >= '0' && *p <= '9') || (*p >= 'a' && *p <= 'f')))
+            return 0;
+    return sl_node_id_valid(node);
+}
+
 /* Integer member in [lo, hi]: 1 present and valid, 0 absent, -1 bad. */
 static int get_int(const cJSON *root, const char *key, double lo, double hi, long long *out)
 {
@@ -133,6 +158,10 @@ sl_status sl_msg_parse(const char *text, size_t len, sl_msg *msg, char *code, ch
         msg->type = SL_MSG_HELLO;
         if (get_string(root, "session", msg->session, sizeof msg->session) < 0)
             return fail(msg, code, field, "bad_field", "session", err, "\"session\" must be a string of < %s bytes", "64");
+        if (msg->session[0] && !sl_session_id_valid(msg->session))
+            return fail(msg, code, field, "bad_field", "session", err,
+                        "\"session\" must be NODE.HEX: a node id of 1-32 [A-Za-z0-9_-], '.', %s lowercase hex digits",
+                        "16");
         if (get_string(root, "token", msg->token, sizeof msg->token) < 0)
             return fail(msg, code, field, "bad_field", "token", err, "\"token\" must be a string of < %s bytes", "64");
         /* fall through: width/height are shared with resize */
@@ -454,6 +483,7 @@ char *sl_msg_welcome_text(const sl_msg_welcome *w)
     cJSON_AddNumberToObject(o, "version", SL_PROTO_VERSION);
     cJSON_AddStringToObject(o, "session", w->session);
     cJSON_AddStringToObject(o, "token", w->token);
+    cJSON_AddStringToObject(o, "node", w->node ? w->node : "");
     cJSON_AddNumberToObject(o, "client", w->client);
     cJSON_AddStringToObject(o, "role", w->is_controller ? "controller" : "viewer");
     cJSON_AddItemToObject(o, "state", w->state ? w->state : cJSON_CreateNull());

@@ -30,6 +30,9 @@
 #define SL_PROTO_NAME_MAX 128                   /* dataset and technique names */
 #define SL_PROTO_MAX_SIZE 4096                  /* largest width or height a client may ask */
 #define SL_PROTO_ACK_WINDOW 2                   /* unacknowledged frames a client may have */
+#define SL_NODE_ID_MAX 32                       /* characters of a node id ([A-Za-z0-9_-]) */
+#define SL_SESSION_HEX 16                       /* hex digits after the node id in a session id */
+#define SL_SESSION_ID_SIZE (SL_NODE_ID_MAX + 1 + SL_SESSION_HEX + 1) /* "NODE.<hex>" and its NUL */
 
 typedef enum sl_msg_type {
     SL_MSG_INVALID = 0,
@@ -95,6 +98,12 @@ typedef struct sl_msg {
     char format[8];                   /* record: "mp4" or "webm" */
     int crf;                          /* record: -1 = the codec's default */
 } sl_msg;
+
+/* 1 when s is a node id: 1..SL_NODE_ID_MAX characters of [A-Za-z0-9_-]. */
+int sl_node_id_valid(const char *s);
+/* 1 when s is a session id: a node id, '.', and SL_SESSION_HEX lowercase hex
+ * digits (sessions are named by the node that made them, PROTOCOL.md). */
+int sl_session_id_valid(const char *s);
 
 /* Parses one client text message of `len` bytes (need not be NUL-terminated).
  * On failure returns SL_ERR_INVALID, fills err, writes a stable error code
@@ -183,6 +192,7 @@ char *sl_msg_state_text(uint32_t version, cJSON *patch);
  * so the page holds no camera numbers of its own. */
 typedef struct sl_msg_welcome {
     const char *session, *token;
+    const char *node;              /* the node serving the session (--node-id) */
     int client;
     int is_controller;
     cJSON *state;                  /* consumed: sl_msg_state_json */

@@ -14,7 +14,8 @@
  * "Paths", stored as the JSON text the server checked) at
  * SL_CATALOG_MAX_PATHS rows of at most SL_CATALOG_MAX_PATH_BYTES each.
  * Schema 3 added `paths`; an older file gets the table at open (CREATE IF
- * NOT EXISTS) and its schema_version raised.
+ * NOT EXISTS) and its schema_version raised. Schema 4 made `sessions` the
+ * session checkpoints of every node (id, node, token_hash, state).
  * Used by the lws service thread (server) or the `catalog` CLI, never both
  * on one connection, never from the render thread.
  */
@@ -45,9 +46,9 @@ static const char *schema_sql =
     " technique TEXT NOT NULL, params TEXT NOT NULL, camera TEXT NOT NULL,"
     " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
     "CREATE TABLE IF NOT EXISTS sessions("
-    " id TEXT PRIMARY KEY, state TEXT NOT NULL,"
-    " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')),"
-    " updated TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
+    " id TEXT PRIMARY KEY, node TEXT NOT NULL, token_hash TEXT NOT NULL, state TEXT NOT NULL,"
+    " created TEXT DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')),"
+    " updated TEXT DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
     "CREATE TABLE IF NOT EXISTS removed("
     " name TEXT PRIMARY KEY,"
     " removed TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
@@ -56,12 +57,28 @@ static const char *schema_sql =
     " keys INTEGER NOT NULL, duration REAL NOT NULL,"
     " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
     "CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '3');"
-    "UPDATE meta SET value = '3' WHERE key = 'schema_version' AND CAST(value AS INTEGER) < 3;";
+    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '4');"
+    "UPDATE meta SET value = '4' WHERE key = 'schema_version' AND CAST(value AS INTEGER) < 4;";
 
 static sl_status db_fail(sqlite3 *db, sl_err *err, const char *what)
 {
     return sl_err_set(err, SL_ERR_IO, "catalog: %s: %s", what, sqlite3_errmsg(db));
+}
+
+/* Before schema 4, `sessions` held (id, state) rows that lived only while
+ * their server ran; such a table is dropped at open and made anew with
+ * node and token_hash (schema_sql). */
+static int sessions_table_is_old(sqlite3 *db)
+{
+    sqlite3_stmt *q = NULL;
+    int has_table = 0, has_node = 0;
+    if (sqlite3_prepare_v2(db, "SELECT name FROM pragma_table_info('sessions')", -1, &q, NULL) == SQLITE_OK)
+        while (sqlite3_step(q) == SQLITE_ROW) {
+            has_table = 1;
+            has_node |= strcmp((const char *)sqlite3_column_text(q, 0), "node") == 0;
+        }
+    sqlite3_finalize(q);
+    return has_table && !has_node;
 }
 
 sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err)
@@ -78,6 +95,7 @@ sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err)
     sqlite3_busy_timeout(db, 2000);
     char *msg = NULL;
     if (sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &msg) != SQLITE_OK ||
+        sqlite3_exec(db, sessions_table_is_old(db) ? "DROP TABLE sessions" : "", NULL, NULL, &msg) != SQLITE_OK ||
         sqlite3_exec(db, schema_sql, NULL, NULL, &msg) != SQLITE_OK) {
         sl_status st = sl_err_set(err, SL_ERR_IO, "catalog: cannot initialise %s: %s", path, msg ? msg : "?");
         sqlite3_free(msg);
@@ -674,30 +692,67 @@ cJSON *sl_catalog_list_paths_json(sqlite3 *db)
     return arr;
 }
 
-sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *state_json, sl_err *err)
+sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *node, const char *token_hash,
+                                 const char *state_json, sl_err *err)
 {
     sqlite3_stmt *q = NULL;
     if (sqlite3_prepare_v2(db,
-                           "INSERT INTO sessions(id, state) VALUES(?1, ?2) ON CONFLICT(id) DO UPDATE SET"
+                           "INSERT INTO sessions(id, node, token_hash, state) VALUES(?1, ?2, ?3, ?4)"
+                           " ON CONFLICT(id) DO UPDATE SET node = excluded.node, token_hash = excluded.token_hash,"
                            " state = excluded.state, updated = strftime('%Y-%m-%dT%H:%M:%SZ','now')",
                            -1, &q, NULL) != SQLITE_OK)
         return db_fail(db, err, "prepare session_put");
     sqlite3_bind_text(q, 1, id, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 2, state_json, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(q, 2, node, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(q, 3, token_hash, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(q, 4, state_json, -1, SQLITE_TRANSIENT);
     int rc = sqlite3_step(q);
     sqlite3_finalize(q);
     return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "session_put");
 }
 
-sl_status sl_catalog_sessions_clear(sqlite3 *db, sl_err *err)
+sl_status sl_catalog_session_get(sqlite3 *db, const char *id, char **state_json, char token_hash[65], char *node,
+                                 size_t node_size, sl_err *err)
 {
-    char *msg = NULL;
-    if (sqlite3_exec(db, "DELETE FROM sessions", NULL, NULL, &msg) != SQLITE_OK) {
-        sl_status st = sl_err_set(err, SL_ERR_IO, "catalog: cannot clear sessions: %s", msg ? msg : "?");
-        sqlite3_free(msg);
-        return st;
+    *state_json = NULL;
+    token_hash[0] = '\0';
+    if (node_size)
+        node[0] = '\0';
+    sqlite3_stmt *q = NULL;
+    if (sqlite3_prepare_v2(db, "SELECT state, token_hash, node FROM sessions WHERE id = ?1", -1, &q, NULL) !=
+        SQLITE_OK)
+        return db_fail(db, err, "prepare session_get");
+    sqlite3_bind_text(q, 1, id, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(q);
+    sl_status st = SL_OK;
+    if (rc == SQLITE_ROW) {
+        const char *state = (const char *)sqlite3_column_text(q, 0);
+        const char *hash = (const char *)sqlite3_column_text(q, 1);
+        const char *owner = (const char *)sqlite3_column_text(q, 2);
+        *state_json = strdup(state ? state : "");
+        snprintf(token_hash, 65, "%s", hash ? hash : "");
+        if (node_size)
+            snprintf(node, node_size, "%s", owner ? owner : "");
+        if (!*state_json)
+            st = sl_err_set(err, SL_ERR_NOMEM, "catalog: out of memory reading the checkpoint of %s", id);
+    } else if (rc == SQLITE_DONE) {
+        st = sl_err_set(err, SL_ERR_INVALID, "catalog: no checkpoint of session %s", id);
+    } else {
+        st = db_fail(db, err, "session_get");
     }
-    return SL_OK;
+    sqlite3_finalize(q);
+    return st;
+}
+
+sl_status sl_catalog_sessions_clear_node(sqlite3 *db, const char *node, sl_err *err)
+{
+    sqlite3_stmt *q = NULL;
+    if (sqlite3_prepare_v2(db, "DELETE FROM sessions WHERE node = ?1", -1, &q, NULL) != SQLITE_OK)
+        return db_fail(db, err, "prepare sessions_clear_node");
+    sqlite3_bind_text(q, 1, node, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(q);
+    sqlite3_finalize(q);
+    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "sessions_clear_node");
 }
 
 sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err)

@@ -1,5 +1,10 @@
 /* http.c — the bodies of GET /healthz (JSON) and GET /metrics (Prometheus text 0.0.4).
  *
+ * /healthz names the node and says "ok" (200), "draining" (503: SIGTERM,
+ * no new sessions) or "unavailable" (503: no renderer, stopping); a
+ * balancer must not use it as its health check for a draining node still
+ * serves its sessions (the agent-check, agent.c, says drain instead).
+ *
  * Metrics are counters and gauges read under srv->lock in one pass, so a
  * scrape sees one consistent snapshot; the two histograms (render ms and
  * encode ms per frame) use fixed millisecond buckets. Does not send
@@ -28,13 +33,16 @@ void sl_histogram_add(sl_histogram *h, double ms)
 char *sl_http_healthz(sl_server *srv, int *status)
 {
     pthread_mutex_lock(&srv->lock);
-    int ok = srv->render_ready > 0 && !srv->stop;
+    int up = srv->render_ready > 0 && !srv->stop, ok = up && !srv->draining;
     cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "status", ok ? "ok" : "unavailable");
+    cJSON_AddStringToObject(o, "node", srv->cfg.node_id);
+    cJSON_AddStringToObject(o, "status", ok ? "ok" : up ? "draining" : "unavailable");
     cJSON_AddNumberToObject(o, "uptime_s", (sl_clock_ms() - srv->start_ms) / 1000.0);
     cJSON_AddNumberToObject(o, "sessions", srv->session_count);
     cJSON_AddNumberToObject(o, "clients", srv->client_count);
     cJSON_AddNumberToObject(o, "pending", srv->pending_count);
+    cJSON_AddNumberToObject(o, "render_queue", sl_sessions_render_queue_locked(srv));
+    cJSON_AddNumberToObject(o, "last_frame_ms", srv->last_frame_ms);
     cJSON_AddStringToObject(o, "renderer", srv->gpu_renderer);
     cJSON_AddNumberToObject(o, "protocol", SL_PROTO_VERSION);
     pthread_mutex_unlock(&srv->lock);
@@ -89,7 +97,8 @@ char *sl_http_metrics(sl_server *srv)
     pthread_mutex_lock(&srv->lock);
     sl_metrics m = srv->metrics;
     int sessions = srv->session_count, clients = srv->client_count, pending = srv->pending_count;
-    int prepared = srv->prepared_scenes;
+    int prepared = srv->prepared_scenes, draining = srv->draining;
+    int queue = sl_sessions_render_queue_locked(srv);
     pthread_mutex_unlock(&srv->lock);
     struct { const char *name, *help; uint64_t v; } counters[] = {
         {"sightline_frames_rendered_total", "Frames rendered and encoded.", m.frames_rendered},
@@ -115,6 +124,12 @@ char *sl_http_metrics(sl_server *srv)
     for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
         append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,
                counters[i].name, counters[i].name, (unsigned long long)counters[i].v);
+    append(&b, &len, &cap, "# HELP sightline_node_info This node's id (--node-id), in the label.\n"
+           "# TYPE sightline_node_info gauge\nsightline_node_info{node=\"%s\"} 1\n", srv->cfg.node_id);
+    append(&b, &len, &cap, "# HELP sightline_draining 1 while the node drains (SIGTERM): no new sessions.\n"
+           "# TYPE sightline_draining gauge\nsightline_draining %d\n", draining);
+    append(&b, &len, &cap, "# HELP sightline_render_queue Sessions waiting for a render.\n"
+           "# TYPE sightline_render_queue gauge\nsightline_render_queue %d\n", queue);
     append(&b, &len, &cap, "# HELP sightline_clients WebSocket clients past hello.\n# TYPE sightline_clients gauge\n"
            "sightline_clients %d\n", clients);
     append(&b, &len, &cap, "# HELP sightline_pending_connections WebSocket connections that have not sent hello.\n"

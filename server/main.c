@@ -4,7 +4,7 @@
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
  *                    [--max-pending N] [--max-pending-per-address N]
  *                    [--max-sessions N] [--grace S] [--idle-release S] [--egl-device D]
- *                    [--default-dataset NAME] [--hello-timeout S]
+ *                    [--default-dataset NAME] [--hello-timeout S] [--node-id NAME] [--agent-port P]
  *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]
  *                    [--test-load-delay-ms MS]   (the --test-* options are for tests only)
  *   sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
@@ -13,7 +13,9 @@
  *
  * The work is elsewhere (see sl_server.h for the map): this file opens the
  * catalog, starts the render thread (render.c), creates the lws context
- * (ws.c) and runs the service loop on the main thread until SIGINT/SIGTERM.
+ * (ws.c) and runs the service loop on the main thread until SIGINT or a
+ * second SIGTERM; the first SIGTERM drains (no new sessions; the node exits
+ * 0 once no session has clients or --grace seconds passed, session.c).
  * Stop order matters: render thread first (it calls lws_cancel_service),
  * then the lws context (closing clients), then sessions, then the catalog.
  * --port 0 picks a free port; the chosen one is printed as
@@ -37,12 +39,33 @@
 #define SL_SOURCE_DIR "."
 #endif
 
-static volatile sig_atomic_t interrupted;
+static volatile sig_atomic_t interrupted, drain_requested;
 
+/* SIGINT stops at once; the first SIGTERM asks for a drain, a second stops at once. */
 static void on_signal(int sig)
 {
-    (void)sig;
-    interrupted = 1;
+    if (sig == SIGTERM && !drain_requested)
+        drain_requested = 1;
+    else
+        interrupted = 1;
+}
+
+/* The host name as a node id: every character outside [A-Za-z0-9_-]
+ * becomes '-', at most SL_NODE_ID_MAX of them; "node" when there is none. */
+static void default_node_id(char out[SL_NODE_ID_MAX + 1])
+{
+    char host[256] = "";
+    if (gethostname(host, sizeof host - 1) != 0)
+        host[0] = '\0';
+    size_t n = 0;
+    for (; host[n] && n < SL_NODE_ID_MAX; n++) {
+        char ch = host[n];
+        int ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_';
+        out[n] = ok ? ch : '-';
+    }
+    out[n] = '\0';
+    if (n == 0)
+        snprintf(out, SL_NODE_ID_MAX + 1, "node");
 }
 
 static void usage(FILE *f)
@@ -52,14 +75,21 @@ static void usage(FILE *f)
             "                        [--allow-origin URL]... [--max-clients N] [--max-pending N]\n"
             "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--idle-release SECONDS] [--egl-device software|INDEX] [--default-dataset NAME]\n"
-            "                        [--hello-timeout S]\n"
+            "                        [--hello-timeout S] [--node-id NAME] [--agent-port P]\n"
             "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-load-delay-ms MS]\n"
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
             "                        frame's render, and MS before every dataset load, so a scene is slow in a\n"
             "                        known way)\n"
             "       sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list\n"
             "                        | remove NAME | scan DIR | add-builtins\n"
-            "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n");
+            "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n"
+            "  --node-id NAME    this node in session ids (NAME.<hex>), welcome, /healthz, /metrics and\n"
+            "                    the catalog's checkpoints: 1-32 of [A-Za-z0-9_-] (default: the host name so\n"
+            "                    sanitized); nodes sharing one catalog need distinct ids\n"
+            "  --agent-port P    HAProxy agent-check on TCP port P (0, the default: off): \"up ready W%%\"\n"
+            "                    (W falls with the sessions), \"drain\" while draining\n"
+            "  SIGTERM drains: no new sessions (`draining`), existing ones are served until their clients\n"
+            "  leave or --grace seconds pass, then exit 0; a second SIGTERM or SIGINT stops at once\n");
 }
 
 static int dir_exists(const char *p)
@@ -177,6 +207,7 @@ int main(int argc, char **argv)
     cfg.db_path = db_default;
     snprintf(web_default, sizeof web_default, "%s", dir_exists("web") ? "web" : SL_SOURCE_DIR "/web");
     cfg.web_dir = web_default;
+    default_node_id(cfg.node_id);
     int catalog_at = 0;
     char *positional[4];
     int npos = 0;
@@ -231,6 +262,15 @@ int main(int argc, char **argv)
             int ms = 0;
             ok = parse_int(v, 0, 60000, &ms), i++;
             cfg.test_load_delay_ms = ms;
+        } else if (strcmp(a, "--node-id") == 0 && v) {
+            if (!sl_node_id_valid(v)) {
+                fprintf(stderr, "sightline-server: --node-id \"%s\": a node id is 1-%d characters of "
+                        "[A-Za-z0-9_-]\n", v, SL_NODE_ID_MAX);
+                return 2;
+            }
+            snprintf(cfg.node_id, sizeof cfg.node_id, "%s", v), i++;
+        } else if (strcmp(a, "--agent-port") == 0 && v) {
+            ok = parse_int(v, 0, 65535, &cfg.agent_port), i++;
         } else if (strcmp(a, "--default-dataset") == 0 && v) {
             cfg.default_dataset = v, i++;
         } else if (strcmp(a, "--egl-device") == 0 && v) {
@@ -277,7 +317,7 @@ int main(int argc, char **argv)
     int rc = 1, port = 0;
     if (sl_catalog_open(cfg.db_path, &srv->db, &err) != SL_OK ||
         sl_catalog_init_defaults(srv->db, cfg.data_dirs, cfg.data_dir_count, &err) != SL_OK ||
-        sl_catalog_sessions_clear(srv->db, &err) != SL_OK) {
+        sl_catalog_sessions_clear_node(srv->db, cfg.node_id, &err) != SL_OK) {
         fprintf(stderr, "sightline-server: %s\n", err.message);
         goto done;
     }
@@ -301,15 +341,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "sightline-server: %s\n", err.message);
         goto done;
     }
+    if (sl_agent_start(srv, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+        goto done;
+    }
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     signal(SIGPIPE, SIG_IGN);
-    printf("sightline-server: renderer %s\n", srv->gpu_renderer);
+    printf("sightline-server: node %s, renderer %s\n", cfg.node_id, srv->gpu_renderer);
+    if (cfg.agent_port > 0)
+        printf("sightline-server: agent-check on %s:%d\n", cfg.bind, cfg.agent_port);
     printf("sightline-server: listening on http://%s:%d/\n", cfg.bind, port);
     fflush(stdout);
-    sl_ws_run(srv, &interrupted);
+    sl_ws_run(srv, &interrupted, &drain_requested);
     rc = 0;
 done:
+    sl_agent_stop(srv);
     sl_render_stop(srv);
     sl_ws_destroy(srv);
     sl_sessions_destroy_all(srv); /* removes every recording file */

@@ -509,6 +509,12 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     s->latest = f;
     s->rendered_version = st->version;
     s->rendered_interactive = interactive;
+    if (!interactive && st->version > s->checkpoint_version) {
+        /* A still of a state not checkpointed yet: the service thread writes the checkpoint (it owns the DB). */
+        s->checkpoint_version = st->version;
+        s->checkpoint_due = 1;
+    }
+    srv->last_frame_ms = render_ms + encode_ms;
     srv->metrics.frames_rendered++;
     sl_histogram_add(&srv->metrics.render_ms, render_ms);
     sl_histogram_add(&srv->metrics.encode_ms, encode_ms);

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/random.h>
+#include <time.h>
 
 #include <libwebsockets.h>
 
@@ -100,8 +101,7 @@ static void send_error(sl_server *srv, sl_client *c, const char *code, const cha
     sl_client_queue_text(c, sl_msg_error_text(code, message, field));
 }
 
-/* The session's state object (sl_msg_state_json); service thread. */
-static cJSON *state_json(const sl_session *s)
+cJSON *sl_session_state_json(const sl_session *s)
 {
     const sl_session_state *st = &s->state;
     sl_msg_state m = {.version = st->version, .dataset = st->dataset, .technique = st->technique,
@@ -109,15 +109,6 @@ static cJSON *state_json(const sl_session *s)
                       .width = st->width, .height = st->height, .background = st->background, .stream = &st->stream,
                       .controller = s->controller, .bounds = s->bounds};
     return sl_msg_state_json(&m);
-}
-
-static void persist(sl_server *srv, sl_session *s)
-{
-    char *text = print_and_free(state_json(s));
-    sl_err err = {0};
-    if (text && sl_catalog_session_put(srv->db, s->id, text, &err) != SL_OK)
-        fprintf(stderr, "sightline-server: %s\n", err.message);
-    free(text);
 }
 
 /* Merges patch (consumed) into every client's pending patch: newest value of each key wins. */
@@ -218,7 +209,10 @@ static sl_status pick_default_dataset(sl_server *srv, const sl_technique *t, sl_
     return rc;
 }
 
-static sl_session *create_session(sl_server *srv, int width, int height, sl_err *err)
+/* A zeroed session for a new or restored one, after evicting the oldest
+ * session without clients when --max-sessions are live; NULL (err set)
+ * when every session has clients or memory is short. */
+static sl_session *alloc_session(sl_server *srv, sl_err *err)
 {
     /* Evict the oldest session without clients when at the cap. */
     if (srv->session_count >= srv->cfg.max_sessions) {
@@ -241,11 +235,33 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
         sl_catalog_session_remove(srv->db, id, err);
     }
     sl_session *s = calloc(1, sizeof *s);
-    if (!s) {
+    if (!s)
         sl_err_set(err, SL_ERR_NOMEM, "session allocation failed");
+    return s;
+}
+
+/* Puts a filled session on the list (the render thread sees it from here on). */
+static void insert_session(sl_server *srv, sl_session *s)
+{
+    s->empty_since_ms = sl_clock_ms();
+    s->idle_since_ms = s->empty_since_ms;
+    pthread_mutex_lock(&srv->lock);
+    s->next = srv->sessions;
+    srv->sessions = s;
+    srv->session_count++;
+    pthread_cond_signal(&srv->wake);
+    pthread_mutex_unlock(&srv->lock);
+}
+
+static sl_session *create_session(sl_server *srv, int width, int height, sl_err *err)
+{
+    sl_session *s = alloc_session(srv, err);
+    if (!s)
         return NULL;
-    }
-    sl_random_hex(s->id, 8);
+    /* "NODE.<16 hex>": the node id tells a balancer and a reader of the catalog who made it. */
+    char hex[SL_SESSION_HEX + 1];
+    sl_random_hex(hex, SL_SESSION_HEX / 2);
+    snprintf(s->id, sizeof s->id, "%s.%s", srv->cfg.node_id, hex);
     sl_random_hex(s->token, 16);
     int tc = 0;
     const sl_technique *const *techs = sl_technique_list(&tc);
@@ -268,15 +284,65 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     st->height = height > 0 ? height : 480;
     st->background[0] = 0.1f; st->background[1] = 0.1f; st->background[2] = 0.12f; st->background[3] = 1.0f;
     st->stream = SL_STREAM_DEFAULTS;
-    s->empty_since_ms = sl_clock_ms();
-    s->idle_since_ms = s->empty_since_ms;
-    pthread_mutex_lock(&srv->lock);
-    s->next = srv->sessions;
-    srv->sessions = s;
-    srv->session_count++;
-    pthread_cond_signal(&srv->wake);
-    pthread_mutex_unlock(&srv->lock);
-    persist(srv, s);
+    insert_session(srv, s);
+    sl_checkpoint_write(srv, s);
+    return s;
+}
+
+/* A session this node does not have, brought back from its checkpoint
+ * (written by whichever node served it last, maybe one that died): same id
+ * and token, so the client keeps its share link; a fresh render. *code is
+ * the error for the client when NULL comes back: unknown_session (no
+ * checkpoint, or one whose grace period ran out), bad_token, or
+ * session_failed (the state does not restore here, or no slot). Two nodes
+ * restoring one session at the same moment both succeed; the last
+ * checkpoint written names the owner (PROTOCOL.md "Nodes"). */
+static sl_session *restore_session(sl_server *srv, const sl_msg *m, const char **code, sl_err *err)
+{
+    char *json = NULL, hash[65], owner[SL_NODE_ID_MAX + 1];
+    *code = "unknown_session";
+    if (sl_catalog_session_get(srv->db, m->session, &json, hash, owner, sizeof owner, err) != SL_OK) {
+        sl_err_set(err, SL_ERR_INVALID, "no such session (it may have expired)");
+        return NULL;
+    }
+    if (!sl_checkpoint_token_matches(m->token, hash)) {
+        free(json);
+        *code = "bad_token";
+        sl_err_set(err, SL_ERR_INVALID, "the join token does not match this session");
+        return NULL;
+    }
+    sl_session_state st;
+    memset(&st, 0, sizeof st);
+    cJSON *bounds = NULL;
+    double empty_since_s = 0;
+    sl_status rc = sl_checkpoint_restore_state(srv, json, &st, &bounds, &empty_since_s, err);
+    free(json);
+    if (rc == SL_OK && empty_since_s > 0 && (double)time(NULL) - empty_since_s > srv->cfg.grace_s) {
+        /* Nobody came back within the grace period: the session ended while it had no node. */
+        sl_err rm = {0};
+        sl_catalog_session_remove(srv->db, m->session, &rm);
+        cJSON_Delete(bounds);
+        sl_err_set(err, SL_ERR_INVALID, "no such session (it expired)");
+        return NULL;
+    }
+    if (rc != SL_OK) {
+        *code = "session_failed";
+        return NULL;
+    }
+    sl_session *s = alloc_session(srv, err);
+    if (!s) {
+        cJSON_Delete(bounds);
+        *code = "session_failed";
+        return NULL;
+    }
+    /* Lengths checked: the parser's session id form, and a token whose hash matched one of 32 digits. */
+    snprintf(s->id, sizeof s->id, "%.*s", (int)sizeof s->id - 1, m->session);
+    snprintf(s->token, sizeof s->token, "%.*s", (int)sizeof s->token - 1, m->token);
+    s->state = st;
+    s->bounds = bounds;
+    insert_session(srv, s);
+    sl_checkpoint_write(srv, s); /* ownership: this node's id in the row */
+    fprintf(stderr, "sightline-server: restored session %s from the checkpoint of node %s\n", s->id, owner);
     return s;
 }
 
@@ -302,8 +368,8 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     pthread_mutex_unlock(&srv->lock);
     c->play_seq = s->play ? s->play_seq - 1 : s->play_seq; /* a path playing is news; a stopped one is not */
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
-    sl_msg_welcome w = {.session = s->id, .token = s->token, .client = c->id,
-                        .is_controller = s->controller == c->id, .state = state_json(s),
+    sl_msg_welcome w = {.session = s->id, .token = s->token, .node = srv->cfg.node_id, .client = c->id,
+                        .is_controller = s->controller == c->id, .state = sl_session_state_json(s),
                         .techniques = cJSON_Duplicate(srv->techniques_json, 1),
                         .datasets = sl_catalog_list_json(srv->db, 0), .max_clients = srv->cfg.max_clients,
                         .grace_s = srv->cfg.grace_s};
@@ -507,10 +573,9 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
     s->state = next;
     state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
-    cJSON *full = state_json(s);
+    cJSON *full = sl_session_state_json(s);
     cJSON_DeleteItemFromObjectCaseSensitive(full, "stream");
     broadcast_patch(s, full);
-    persist(srv, s);
 }
 
 static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
@@ -532,14 +597,28 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
         pthread_mutex_unlock(&srv->lock);
         return;
     }
-    sl_session *s;
-    if (m->session[0]) {
-        s = find_session(srv, m->session);
+    pthread_mutex_lock(&srv->lock);
+    int draining = srv->draining;
+    pthread_mutex_unlock(&srv->lock);
+    sl_session *s = m->session[0] ? find_session(srv, m->session) : NULL;
+    if (!s && draining) {
+        /* New and restored sessions belong on another node; the client reconnects through the balancer. */
+        send_error(srv, c, "draining",
+                   "this node is shutting down and takes no new sessions; reconnect to reach another node", "");
+        c->close_after_send = 1;
+        return;
+    }
+    if (m->session[0] && !s) {
+        const char *code = "unknown_session";
+        sl_err err = {0};
+        s = restore_session(srv, m, &code, &err);
         if (!s) {
-            send_error(srv, c, "unknown_session", "no such session (it may have expired)", "session");
+            send_error(srv, c, code, err.message, strcmp(code, "bad_token") == 0 ? "token"
+                                                  : strcmp(code, "unknown_session") == 0 ? "session" : "");
             c->close_after_send = 1;
             return;
         }
+    } else if (s) {
         /* Compare every byte so timing does not reveal a matching prefix. */
         size_t lt = strlen(s->token), lm = strlen(m->token);
         unsigned diff = (unsigned)(lt ^ lm);
@@ -962,10 +1041,9 @@ static void apply_reverts(sl_server *srv)
             continue;
         cJSON_Delete(s->bounds);
         s->bounds = NULL;
-        cJSON *full = state_json(s);
+        cJSON *full = sl_session_state_json(s);
         cJSON_DeleteItemFromObjectCaseSensitive(full, "stream");
         broadcast_patch(s, full);
-        persist(srv, s);
     }
 }
 
@@ -1001,6 +1079,21 @@ void sl_sessions_on_wake(sl_server *srv)
     }
     pthread_mutex_unlock(&srv->lock);
     apply_reverts(srv);
+    /* Checkpoints the render thread asked for (a still frame of a new state
+     * version): written here, outside the lock, one session per pass. */
+    for (;;) {
+        sl_session *s = NULL;
+        pthread_mutex_lock(&srv->lock);
+        for (sl_session *t = srv->sessions; t && !s; t = t->next)
+            if (!t->doomed && t->checkpoint_due)
+                s = t;
+        if (s)
+            s->checkpoint_due = 0;
+        pthread_mutex_unlock(&srv->lock);
+        if (!s)
+            break;
+        sl_checkpoint_write(srv, s);
+    }
     /* Dataset descriptions from the render thread: taken under the lock, written
      * to the catalog and broadcast outside it (SQLite must not stall rendering). */
     for (;;) {
@@ -1205,4 +1298,49 @@ void sl_sessions_destroy_all(sl_server *srv)
         sl_session_free(s);
         s = next;
     }
+}
+
+void sl_sessions_drain_begin(sl_server *srv)
+{
+    pthread_mutex_lock(&srv->lock);
+    srv->draining = 1;
+    int sessions = srv->session_count, clients = srv->client_count;
+    pthread_mutex_unlock(&srv->lock);
+    srv->drain_start_ms = sl_clock_ms();
+    fprintf(stderr, "sightline-server: draining (SIGTERM): %d session(s), %d client(s); no new sessions; "
+            "a second SIGTERM stops at once\n", sessions, clients);
+}
+
+int sl_sessions_drain_done(sl_server *srv)
+{
+    int busy = 0;
+    pthread_mutex_lock(&srv->lock);
+    for (sl_session *s = srv->sessions; s && !busy; s = s->next)
+        busy = !s->doomed && s->client_count > 0;
+    pthread_mutex_unlock(&srv->lock);
+    if (busy && sl_clock_ms() - srv->drain_start_ms < srv->cfg.grace_s * 1000.0)
+        return 0;
+    /* What stays is handed over: each checkpoint is current, so the node a
+     * client reaches next restores the session as it was. */
+    pthread_mutex_lock(&srv->lock);
+    int n = 0, cap = srv->session_count;
+    sl_session **live = cap > 0 ? malloc(sizeof *live * (size_t)cap) : NULL;
+    for (sl_session *s = srv->sessions; s && live && n < cap; s = s->next)
+        if (!s->doomed)
+            live[n++] = s;
+    pthread_mutex_unlock(&srv->lock);
+    for (int i = 0; i < n; i++) /* valid outside the lock: only this thread dooms a session */
+        sl_checkpoint_write(srv, live[i]);
+    free(live);
+    fprintf(stderr, "sightline-server: drained%s\n", busy ? " (--grace passed; clients left are closed)" : "");
+    return 1;
+}
+
+int sl_sessions_render_queue_locked(const sl_server *srv)
+{
+    int n = 0;
+    for (const sl_session *s = srv->sessions; s; s = s->next)
+        n += !s->doomed && (s->snap_req_count > 0 || s->state.version != s->rendered_version ||
+                            s->rendered_interactive);
+    return n;
 }

@@ -16,6 +16,10 @@
  *   record.c   recording jobs: a camera path rendered into a video in the
  *              background of a session, its status texts and its one-time
  *              download (service thread; the frames render in render.c)
+ *   checkpoint.c  session checkpoints in the catalog: the state a node writes
+ *              at each new still frame and another node restores a session
+ *              from after the first one died; SHA-256 of join tokens (service thread)
+ *   agent.c    the HAProxy agent-check listener (--agent-port; its own thread)
  *   catalog.c  SQLite catalog (service thread and the CLI)
  *   http.c     /healthz and /metrics bodies (service thread)
  *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
@@ -74,6 +78,8 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
+    char node_id[SL_NODE_ID_MAX + 1]; /* --node-id: names this node in session ids, welcome, /healthz */
+    int agent_port;                /* --agent-port: HAProxy agent-check listener, 0 = off */
     int port;                      /* 0: any free port (printed on stdout) */
     const char *bind;              /* default 127.0.0.1 */
     const char *db_path;
@@ -262,7 +268,7 @@ struct sl_client {                  /* [service] */
 };
 
 struct sl_session {
-    char id[33], token[33];                  /* immutable */
+    char id[SL_SESSION_ID_SIZE], token[33];  /* immutable: "NODE.<hex>", 32 hex digits */
     sl_session_state state;                  /* [lock] desired state */
     uint32_t rendered_version;               /* [lock] written by render thread */
     int rendered_interactive;                /* [lock] */
@@ -285,6 +291,9 @@ struct sl_session {
     char revert_failed_source[SL_SOURCE_MAX];/* [lock] */
     sl_session_state revert_to;              /* [lock] */
     int doomed;                              /* [lock] expired; render thread frees */
+    int checkpoint_due;                      /* [lock] set by the render thread when it published a
+                                                still frame of a version not yet checkpointed */
+    uint32_t checkpoint_version;             /* [lock] newest state version flagged for a checkpoint */
     char *info_bounds, *info_counts, *info_attrs; /* [lock] set by the render thread after a load */
     char info_dataset[SL_PROTO_NAME_MAX];    /* [lock] which dataset the info describes */
     int info_pending;                        /* [lock] not yet taken by the service thread */
@@ -361,6 +370,10 @@ typedef struct sl_server {
     sl_metrics metrics;                      /* [lock] */
     int prepared_scenes;                     /* [lock] live prepared scenes (written by the render thread) */
     int stop;                                /* [lock] */
+    int draining;                            /* [lock] SIGTERM: no new sessions; exits when drained */
+    double drain_start_ms;                   /* [service] when draining began */
+    double last_frame_ms;                    /* [lock] render + encode ms of the newest frame (render thread) */
+    struct sl_agent *agent;                  /* [service] the agent-check listener, or NULL */
     int render_ready;                        /* [lock] 1 up, -1 failed */
     char gpu_renderer[128];                  /* [lock] */
     char render_fail[256];                   /* [lock] */
@@ -382,6 +395,8 @@ void sl_session_free(sl_session *s);          /* render thread or shutdown; afte
 /* 2 x bytes lowercase hex digits of getrandom (bytes <= 32) and a NUL into
  * out: session ids, tokens, recording keys. Any thread. */
 void sl_random_hex(char *out, int bytes);
+/* The session's state object (sl_msg_state_json): welcome, patches, checkpoints. Service thread. */
+cJSON *sl_session_state_json(const sl_session *s);
 /* Queues a text message for c (takes ownership of text). Returns -1 when the
  * client's queue is full (the client is then closed). */
 int sl_client_queue_text(sl_client *c, char *text);
@@ -535,10 +550,54 @@ sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *techni
 sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err);
 /* [{name, technique, keys, duration, created}] by name. */
 cJSON *sl_catalog_list_paths_json(sqlite3 *db);
-sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *state_json, sl_err *err);
+/* Session checkpoints (issue 16): one row per live session of any node. state_json is the
+ * sl_msg_state_json text plus whatever the server needs to restore (see session.c);
+ * token_hash is the lowercase hex SHA-256 of the join token (64 chars + NUL), never the token;
+ * node is the owning node id. put is an upsert that also sets `updated`. */
+sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *node, const char *token_hash,
+                                 const char *state_json, sl_err *err);
+/* SL_OK and *state_json (malloc'd, caller frees) when found; SL_ERR_INVALID with a
+ * "no checkpoint" message when not. token_hash gets 65 bytes; node gets node_size bytes. */
+sl_status sl_catalog_session_get(sqlite3 *db, const char *id, char **state_json, char token_hash[65],
+                                 char *node, size_t node_size, sl_err *err);
 sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err);
-/* Sessions live in memory; rows left by a previous run are removed at start. */
-sl_status sl_catalog_sessions_clear(sqlite3 *db, sl_err *err);
+/* At a node's start: removes only the rows of that node (other nodes' sessions survive). */
+sl_status sl_catalog_sessions_clear_node(sqlite3 *db, const char *node, sl_err *err);
+
+/* checkpoint.c (service thread) */
+/* Lowercase hex SHA-256 of token into hex (65 bytes). SL_ERR_NOMEM when libcrypto fails. */
+sl_status sl_checkpoint_token_hash(const char *token, char hex[65], sl_err *err);
+/* 1 when SHA-256(token) equals want_hex, compared in constant time. */
+int sl_checkpoint_token_matches(const char *token, const char *want_hex);
+/* Writes the session's checkpoint (its state, this node as owner, the
+ * token's hash); a failure is logged, the session goes on. */
+void sl_checkpoint_write(sl_server *srv, sl_session *s);
+/* Fills st (zeroed by the caller) from a checkpoint's state_json: the
+ * dataset looked up in the catalog by name, the technique's parameters over
+ * its defaults, the camera checked as a client's would be, size,
+ * background, stream; *bounds the dataset bounds it held (owned, or NULL). *empty_since_s is the wall-clock second at which
+ * the session had no clients any more when that was written (0: it had
+ * clients). SL_ERR_INVALID naming what does not restore. */
+sl_status sl_checkpoint_restore_state(sl_server *srv, const char *state_json, sl_session_state *st,
+                                      cJSON **bounds, double *empty_since_s, sl_err *err);
+
+/* agent.c: the HAProxy agent-check listener on cfg.agent_port (its own thread). */
+/* The one line the agent answers now (lock not held by the caller): "drain\n"
+ * while draining, else "up ready W%\n" (see agent.c for W). out gets 32 bytes. */
+void sl_agent_reply(sl_server *srv, char out[32]);
+sl_status sl_agent_start(sl_server *srv, sl_err *err);
+void sl_agent_stop(sl_server *srv);                 /* NULL agent is fine */
+
+/* session.c: draining (main.c / ws.c, service thread) */
+/* Starts draining: new sessions are refused with `draining`. */
+void sl_sessions_drain_begin(sl_server *srv);
+/* 1 once draining may end: no session has clients, or --grace seconds have
+ * passed since it began. Then every live session's checkpoint is written
+ * (so another node restores it when its clients come back). */
+int sl_sessions_drain_done(sl_server *srv);
+/* Sessions waiting for a render (a snapshot, a state version not rendered,
+ * a still frame owed), the render thread's notion of pending work. Lock held. */
+int sl_sessions_render_queue_locked(const sl_server *srv);
 
 /* http.c */
 char *sl_http_healthz(sl_server *srv, int *status);
@@ -548,7 +607,9 @@ char *sl_http_metrics(sl_server *srv);
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
 /* c no longer waits for hello (it said hello or closes); no-op when not pending. */
 void sl_ws_pending_leave(sl_server *srv, sl_client *c);
-void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted);
+/* Serves until *interrupted; *drain (the first SIGTERM) starts draining, and
+ * the loop ends once sl_sessions_drain_done says so. */
+void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted, volatile sig_atomic_t *drain);
 void sl_ws_destroy(sl_server *srv);
 
 #endif

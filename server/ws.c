@@ -451,11 +451,20 @@ sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
     return SL_OK;
 }
 
-void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted)
+void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted, volatile sig_atomic_t *drain)
 {
-    while (!*interrupted)
+    int draining = 0;
+    while (!*interrupted) {
+        if (*drain && !draining) {
+            sl_sessions_drain_begin(srv);
+            draining = 1;
+        }
+        /* Checked at least once a second: the sweep timer wakes lws_service. */
+        if (draining && sl_sessions_drain_done(srv))
+            break;
         if (lws_service(srv->lws, 0) < 0)
             break;
+    }
 }
 
 void sl_ws_destroy(sl_server *srv)

@@ -7,7 +7,8 @@
 // long loads and prepares (progress.js) and the status line (fps, latency,
 // size, and the load, prepare, render and encode ms separately).
 // The session id and token live in the URL fragment (#session=..&token=..),
-// so a reload or a shared link joins the same session.
+// so a reload or a shared link joins the same session (the id also rides in
+// the WebSocket URL's query for a balancer, protocol.js).
 // window.sightline exposes read-only counters (and the messages the page
 // sent, acks aside) for the browser test.
 
@@ -66,6 +67,7 @@ window.sightline = {
   get cameraLimits() { return { maxElevation: camera.maxElevation, defaults: camera.defaults }; },
   get stateVersion() { return app.stateVersion; },
   get connected() { return conn.ws?.readyState === WebSocket.OPEN; },
+  get wsUrl() { return conn.ws?.url; },
   get progressStage() { return progress.stage; },
   get timings() { return progress.timings; },
   get recording() { return flight.lastJob; },
@@ -338,6 +340,10 @@ conn.addEventListener('message', (ev) => {
       flight.loaded(msg);
       break;
     case 'error':
+      if (msg.code === 'draining') {   // this node is shutting down; the connection retries (protocol.js)
+        setBanner('This server is shutting down — reconnecting to another one…');
+        break;
+      }
       if (msg.code === 'load_failed') progress.hide();
       if (msg.field === 'dataset' || msg.field === 'technique') fillPickers();   // back to the session's pair
       setBanner(`${msg.code}: ${msg.message}${msg.field ? ` (${msg.field})` : ''}`);

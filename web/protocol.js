@@ -1,6 +1,12 @@
 // protocol.js — the sightline.v1 connection (proto/PROTOCOL.md): hello/welcome,
 // JSON messages, binary frame headers, automatic reconnect to the same session.
 // It does not draw or build UI; app.js listens to its events.
+// The session id also goes into the WebSocket URL's query (/ws?session=ID), so
+// a balancer in front of several nodes can route a join or a reconnect to the
+// node that has the session; the server ignores it (hello is the authority).
+// A node that is shutting down answers a new session with `draining` and
+// closes: that is a lost connection like any other, retried with backoff
+// (through the balancer it reaches another node).
 
 export const SUBPROTOCOL = 'sightline.v1';
 export const FRAME_HEADER_SIZE = 40;
@@ -49,7 +55,7 @@ export class Connection extends EventTarget {
     url.protocol = location.protocol === 'https:' ? 'wss:' : 'ws:';
     url.pathname = '/ws';
     url.hash = '';
-    url.search = '';
+    url.search = this.session ? `?session=${encodeURIComponent(this.session)}` : '';
     const ws = new WebSocket(url.toString(), SUBPROTOCOL);
     ws.binaryType = 'arraybuffer';
     this.ws = ws;
@@ -67,7 +73,8 @@ export class Connection extends EventTarget {
           this.token = msg.token;
           this.retry = 0;
         }
-        if (msg.type === 'error' && (msg.code === 'unknown_session' || msg.code === 'bad_token')) {
+        const badLink = msg.code === 'bad_field' && (msg.field === 'session' || msg.field === 'token');
+        if (msg.type === 'error' && (msg.code === 'unknown_session' || msg.code === 'bad_token' || badLink)) {
           // The session expired or the link is wrong: start a fresh one on the next connect.
           this.session = null;
           this.token = null;

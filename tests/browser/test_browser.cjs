@@ -912,7 +912,7 @@ async function main() {
     check(magic === '89504e470d0a1a0a' && download.suggestedFilename().endsWith('.png'), `snapshot is a PNG (${magic})`);
     await page.fill('#view-name', 'browser view');
     const link0 = await page.inputValue('#share-link');
-    const sess = { session: link0.match(/session=([0-9a-f]+)/)[1], token: link0.match(/token=([0-9a-f]+)/)[1] };
+    const sess = { session: decodeURIComponent(link0.match(/session=([^&]+)/)[1]), token: link0.match(/token=([0-9a-f]+)/)[1] };
     const obs = await browser.newPage();
     await obs.goto(`http://127.0.0.1:${port}/healthz`);
     const saved = { name: 'browser view', state: await observeOnce(obs, sess.session, sess.token) };
@@ -926,12 +926,15 @@ async function main() {
 
     // 4. The share link opens the same session in a second page: same frame, same pixels.
     const link = await page.inputValue('#share-link');
-    check(/#session=[0-9a-f]{16}&token=[0-9a-f]{32}$/.test(link), `share link ${link}`);
+    check(/#session=[A-Za-z0-9_-]{1,32}\.[0-9a-f]{16}&token=[0-9a-f]{32}$/.test(link), `share link ${link}`);
     const page2 = await browser.newPage({ viewport: { width: 900, height: 600 } });
     page2.on('pageerror', (e) => { failed++; console.error(`page2 error: ${e.message}`); });
     await page2.goto(link);
     await page2.waitForFunction(() => window.sightline && window.sightline.frames > 0, null, { timeout: T });
     check((await page2.textContent('#role')) === 'viewer', 'second page is a viewer');
+    // The session id rides in the WebSocket URL's query too, for a balancer (PROTOCOL.md).
+    const wsUrl = await page2.evaluate(() => window.sightline.wsUrl);
+    check(new URL(wsUrl).searchParams.get('session') === sess.session, `join URL ${wsUrl} names the session`);
     const id1 = await page.evaluate(() => window.sightline.lastFrame.frameId);
     await page2.waitForFunction((n) => window.sightline.lastFrame.frameId === n, id1, { timeout: T });
     const a = await canvasStats(page), b = await canvasStats(page2);
@@ -950,8 +953,9 @@ async function main() {
     await obs.close();
 
     // 5. Server restart: a clear disconnect message, then automatic reconnect and frames again.
+    // SIGINT stops at once (SIGTERM would drain: serve the connected page until it leaves).
     const framesBefore = await page.evaluate(() => window.sightline.frames);
-    proc.kill('SIGTERM');
+    proc.kill('SIGINT');
     await new Promise((r) => { proc.on('exit', r); setTimeout(r, 15000); });
     await page.waitForFunction(() => !document.getElementById('banner').hidden &&
       /Disconnected/.test(document.getElementById('banner').textContent), null, { timeout: T });
@@ -963,7 +967,7 @@ async function main() {
     console.error(`browser test aborted: ${e.stack || e}`);
   } finally {
     await browser.close();
-    proc.kill('SIGTERM');
+    proc.kill('SIGINT');
     await new Promise((r) => { proc.on('exit', r); setTimeout(r, 15000); });
     fs.rmSync(dir, { recursive: true, force: true });
   }

@@ -212,7 +212,7 @@ int main(void)
     tclient a;
     SL_CHECK(tclient_connect(&a, h.port, NULL) == 0);
     SL_CHECK(tclient_hello(&a, NULL, NULL, W, H) == 0);
-    SL_CHECK(strlen(a.session) == 16 && strlen(a.token) == 32);
+    SL_CHECK(sl_session_id_valid(a.session) && strlen(a.token) == 32); /* NODE.<16 hex> */
     SL_CHECK(a.client_id > 0);
     const cJSON *wst = cJSON_GetObjectItemCaseSensitive(a.welcome, "state");
     SL_CHECK(cJSON_GetObjectItemCaseSensitive(wst, "width")->valueint == W);

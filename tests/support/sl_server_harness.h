@@ -5,8 +5,11 @@
  * registers a small generated dataset "tiny" (so sessions load in
  * milliseconds even under ASan), starts $SIGHTLINE_BINARY_DIR/bin/sightline-server
  * on 127.0.0.1 with --port 0 and reads the chosen port from its stdout.
- * harness_stop sends SIGTERM and returns the exit status, so a leak (ASan)
- * or a crash at shutdown fails the test. tclient wraps sl_wsclient: it
+ * harness_stop sends SIGINT (an immediate stop; SIGTERM would drain) and
+ * returns the exit status, so a leak (ASan) or a crash at shutdown fails
+ * the test. harness_start_shared starts another server (another node) on
+ * the catalog file of a running harness; harness_signal and harness_wait
+ * let a test kill a node or watch it drain. tclient wraps sl_wsclient: it
  * parses text messages into cJSON, records every binary frame (header +
  * payload copy) and acks frames when auto_ack is set. harness_cli_render
  * renders a reference with sightline-render. Loopback only.
@@ -65,8 +68,10 @@ static __attribute__((unused)) int harness_run_wait(char *const argv[])
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/* extra: NULL-terminated extra server arguments (may be NULL). Returns 0 on success. */
-static __attribute__((unused)) int harness_start(harness *h, const char *const *extra)
+/* extra: NULL-terminated extra server arguments (may be NULL). shared: NULL
+ * for a catalog of its own, or a started harness whose catalog file and
+ * data dir this server uses too (stop this one first). Returns 0 on success. */
+static __attribute__((unused)) int harness_start_shared(harness *h, const harness *shared, const char *const *extra)
 {
     memset(h, 0, sizeof *h);
     h->pid = -1;
@@ -82,9 +87,13 @@ static __attribute__((unused)) int harness_start(harness *h, const char *const *
     snprintf(data, sizeof data, "%s/data", h->dir);
     mkdir(data, 0755);
     snprintf(h->db, sizeof h->db, "%s/catalog.db", h->dir);
+    if (shared) {
+        snprintf(h->db, sizeof h->db, "%s", shared->db);
+        snprintf(data, sizeof data, "%s/data", shared->dir);
+    }
     snprintf(web, sizeof web, "%s/web", src ? src : ".");
     char *reg[] = {h->exe, "catalog", "add-generator", "tiny", HARNESS_TINY, "--db", h->db, "--data-dir", data, NULL};
-    int rc = harness_run_wait(reg);
+    int rc = shared ? 0 : harness_run_wait(reg);
     if (rc != 0) {
         fprintf(stderr, "harness: catalog add-generator exited %d\n", rc);
         return -1;
@@ -161,6 +170,38 @@ static __attribute__((unused)) int harness_start(harness *h, const char *const *
     return -1;
 }
 
+static __attribute__((unused)) int harness_start(harness *h, const char *const *extra)
+{
+    return harness_start_shared(h, NULL, extra);
+}
+
+/* Sends sig to the server (nothing when it is not running). */
+static __attribute__((unused)) void harness_signal(harness *h, int sig)
+{
+    if (h->pid > 0)
+        kill(h->pid, sig);
+}
+
+/* Waits up to timeout_ms for the server to exit: its exit status (-1 when a
+ * signal ended it), or -2 when it is still running. */
+static __attribute__((unused)) int harness_wait(harness *h, int timeout_ms)
+{
+    if (h->pid <= 0)
+        return -1;
+    double deadline = sl_clock_ms() + timeout_ms;
+    int status = 0;
+    for (;;) {
+        pid_t r = waitpid(h->pid, &status, WNOHANG);
+        if (r == h->pid) {
+            h->pid = -1;
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+        if (sl_clock_ms() > deadline)
+            return -2;
+        usleep(20000);
+    }
+}
+
 /* The server's stderr is kept in dir/server.log. LeakSanitizer reports
  * whose every allocation is called from "<unknown module>" come from Mesa's
  * driver, which eglTerminate unloads before the report (so lsan.supp cannot
@@ -210,7 +251,7 @@ static __attribute__((unused)) int harness_stop(harness *h)
 {
     int result = -1;
     if (h->pid > 0) {
-        kill(h->pid, SIGTERM);
+        kill(h->pid, SIGINT);
         double deadline = sl_clock_ms() + 20000;
         int status = 0;
         for (;;) {

@@ -39,8 +39,21 @@ int main(void)
     /* hello */
     SL_CHECK(parse("{\"type\":\"hello\",\"version\":1,\"width\":320,\"height\":200}") == SL_OK);
     SL_CHECK(msg.type == SL_MSG_HELLO && msg.version == 1 && msg.width == 320 && msg.height == 200 && !msg.session[0]);
-    SL_CHECK(parse("{\"type\":\"hello\",\"version\":1,\"session\":\"abc\",\"token\":\"def\"}") == SL_OK);
-    SL_CHECK(strcmp(msg.session, "abc") == 0 && strcmp(msg.token, "def") == 0 && msg.width == 0);
+    SL_CHECK(parse("{\"type\":\"hello\",\"version\":1,\"session\":\"node-1_A.0123456789abcdef\",\"token\":\"def\"}")
+             == SL_OK);
+    SL_CHECK(strcmp(msg.session, "node-1_A.0123456789abcdef") == 0 && strcmp(msg.token, "def") == 0 && msg.width == 0);
+    /* Session ids are NODE.HEX (issue 16): a node id of 1-32 [A-Za-z0-9_-], '.', 16 lowercase hex digits. */
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\"abc\",\"token\":\"def\"}", "bad_field",
+                        "session"));
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\".0123456789abcdef\"}", "bad_field", "session"));
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\"a b.0123456789abcdef\"}", "bad_field",
+                        "session"));
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\"n.0123456789ABCDEF\"}", "bad_field", "session"));
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\"n.0123456789abcde\"}", "bad_field", "session"));
+    SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"session\":\"aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa.0123456789abcdef\"}",
+                        "bad_field", "session")); /* a 33-character node id */
+    SL_CHECK(sl_node_id_valid("aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa") && !sl_node_id_valid("") && !sl_node_id_valid("a.b"));
+    SL_CHECK(sl_session_id_valid("aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa.0123456789abcdef"));
     SL_CHECK(fails_with("{\"type\":\"hello\"}", "bad_field", "version"));
     SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"width\":5000}", "bad_field", "width"));
     SL_CHECK(fails_with("{\"type\":\"hello\",\"version\":1,\"height\":0}", "bad_field", "height"));
