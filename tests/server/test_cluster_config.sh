@@ -4,7 +4,7 @@
 # generates from docker/haproxy.cfg.template for docker/compose.yaml's nodes, and
 # HAProxy must accept both that file and the loopback layout scripts/cluster starts.
 # Each compose node must run with the node id and agent port HAProxy expects, and
-# reach the catalog the postgres service holds. Containers cannot run here; this
+# open the one shared catalog. Containers cannot run here; this
 # checks the files, not a running cluster (tests/server/test_server_cluster.c does that).
 # Prints "N passed, N failed".
 set -uo pipefail
@@ -24,7 +24,7 @@ for n in $nodes; do
   check 'grep -q "hostname: $n\$" <<<"$block"' "$n has hostname $n"
   agent="$(grep -o '"--agent-port", "[0-9]*"' <<<"$block" | grep -o '[0-9]*')"
   check '[ -n "$agent" ]' "$n has an --agent-port"
-  check 'grep -q "postgresql://[^\"]*@postgres:5432/" <<<"$block"' "$n uses the postgres service as its catalog"
+  check 'grep -q "\"--db\", \"/var/lib/sightline/catalog.db\"" <<<"$block"' "$n uses the shared catalog"
   specs+=(--node "$n=$n:8080=${agent:-0}")
 done
 
