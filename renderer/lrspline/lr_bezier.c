@@ -78,7 +78,7 @@ void sl_lr_bezier_free(sl_lr_bezier *bz)
     free(bz->coef);
     free(bz->hull_min);
     free(bz->hull_max);
-    sl_lr_lookup_deinit(&bz->lookup);
+    sl_lr_lookup_deinit(&bz->own_lookup);
     memset(bz, 0, sizeof *bz);
 }
 
@@ -122,9 +122,18 @@ sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_lookup_kind lookup, i
                              sl_lr_bezier *bz, sl_err *err)
 {
     sl_status st = build_blocks(lr, bz, err);
-    if (st == SL_OK && (st = sl_lr_lookup_init(&bz->lookup, lr, lookup, forest_axis, err)) != SL_OK)
-        sl_lr_bezier_free(bz);
-    return st;
+    if (st != SL_OK)
+        return st;
+    bz->lookup = sl_lr_index_match(lr, lookup, forest_axis);
+    if (!bz->lookup) {
+        if ((st = sl_lr_lookup_init(&bz->own_lookup, lr, lookup, forest_axis, err)) != SL_OK) {
+            sl_lr_bezier_free(bz);
+            return st;
+        }
+        bz->lookup = &bz->own_lookup;
+    }
+    bz->lookup_kind = bz->lookup->kind;
+    return SL_OK;
 }
 
 static sl_status build_blocks(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *err)
@@ -173,6 +182,10 @@ static sl_status build_blocks(const sl_lr_volume *lr, sl_lr_bezier *bz, sl_err *
                             dst[m] += w * b->coef[m];
                     }
                 }
+        }
+        for (int d = 0; d < 3; d++) {
+            bz->domain_lo[d] = e == 0 ? (float)el->lo[d] : fminf(bz->domain_lo[d], (float)el->lo[d]);
+            bz->domain_hi[d] = e == 0 ? (float)el->hi[d] : fmaxf(bz->domain_hi[d], (float)el->hi[d]);
         }
         block_hull(c, n, dim, &bz->hull_min[e], &bz->hull_max[e]);
         if (e == 0 || bz->hull_min[e] < bz->hull_lo)

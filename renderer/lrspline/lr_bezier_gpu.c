@@ -16,7 +16,7 @@
  * bound here, its kind is compiled in by sl_lr_bezier_defines. */
 static sl_status lookup_upload(const sl_lr_bezier *bz, sl_lr_bezier_gpu *gpu, sl_err *err)
 {
-    sl_status st = sl_lr_lookup_gpu_init(&gpu->lookup, &bz->lookup, 0, err);
+    sl_status st = sl_lr_lookup_gpu_init(&gpu->lookup, bz->lookup, 0, err);
     if (st == SL_OK)
         gpu->bytes += gpu->lookup.bytes;
     return st;
@@ -113,18 +113,12 @@ void sl_lr_bezier_defines(const sl_lr_bezier *bz, int want_double, char *out, si
 {
     snprintf(out, size, "#define LR_O0 %d\n#define LR_O1 %d\n#define LR_O2 %d\n#define LR_DIM %d\n"
              "#define LR_DOUBLE %d\n%s", bz->order[0], bz->order[1], bz->order[2], bz->dim, want_double ? 1 : 0,
-             sl_lr_lookup_glsl_define(bz->lookup.kind));
+             sl_lr_lookup_glsl_define(bz->lookup_kind));
 }
 
 void sl_lr_bezier_set_uniforms(unsigned program, const sl_lr_bezier *bz)
 {
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t e = 0; e < bz->element_count; e++)
-        for (int d = 0; d < 3; d++) {
-            lo[d] = fminf(lo[d], (float)bz->lo[e * 3 + (size_t)d]);
-            hi[d] = fmaxf(hi[d], (float)bz->hi[e * 3 + (size_t)d]);
-        }
     glUniform1i(glGetUniformLocation(program, "u_lr_element_count"), (GLint)bz->element_count);
-    glUniform3f(glGetUniformLocation(program, "u_lr_domain_lo"), lo[0], lo[1], lo[2]);
-    glUniform3f(glGetUniformLocation(program, "u_lr_domain_hi"), hi[0], hi[1], hi[2]);
+    glUniform3fv(glGetUniformLocation(program, "u_lr_domain_lo"), 1, bz->domain_lo);
+    glUniform3fv(glGetUniformLocation(program, "u_lr_domain_hi"), 1, bz->domain_hi);
 }

@@ -1,7 +1,8 @@
 /* lr_index.c — the CPU element look-up a model carries (sl_lr_index,
  * sl_lr_find_element in sl_lr.h): the `auto` structure of sl_lr_lookup.h,
  * built once per finished model and read-only afterwards, so any number of
- * threads may query it. */
+ * threads may query it; sl_lr_index_match hands it to whoever would build
+ * the same structure again (the GPU blocks of sl_lr_bezier.h). */
 #include <stdlib.h>
 
 #include "lr_index.h"
@@ -34,4 +35,16 @@ void sl_lr_drop_index(sl_lr_volume *lr)
 long sl_lr_find_element(const sl_lr_volume *lr, const double p[3])
 {
     return lr->index ? sl_lr_lookup_find(lr->index, p) : sl_lr_find_element_linear(lr, p);
+}
+
+const sl_lr_lookup *sl_lr_index_match(const sl_lr_volume *lr, sl_lr_lookup_kind kind, int forest_axis)
+{
+    const sl_lr_lookup *lk = lr->index;
+    if (!lk)
+        return NULL;
+    int default_forest = forest_axis == 0 || forest_axis == SL_LR_FOREST_DEFAULT_AXIS;
+    if (kind == SL_LR_LOOKUP_AUTO || (kind == SL_LR_LOOKUP_TEXTURE && lk->kind == SL_LR_LOOKUP_TEXTURE) ||
+        (kind == SL_LR_LOOKUP_KDFOREST && default_forest && lk->kind == SL_LR_LOOKUP_KDFOREST))
+        return lk;
+    return NULL;
 }

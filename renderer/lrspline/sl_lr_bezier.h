@@ -53,7 +53,16 @@ typedef struct sl_lr_bezier {
     double *coef;           /* element_count * stride, layout as above */
     double *hull_min, *hull_max; /* per element; the magnitude for vectors */
     double hull_lo, hull_hi; /* over all elements */
-    sl_lr_lookup lookup;    /* the element look-up the GPU uses (sl_lr_lookup.h), built with the blocks */
+    float domain_lo[3], domain_hi[3]; /* the union of the element boxes in float (u_lr_domain_lo/hi), once */
+    /* The element look-up the GPU uses (sl_lr_lookup.h): the model's own
+     * index when it is the structure asked for (sl_lr_index_match; borrowed,
+     * so the model must outlive every sl_lr_bezier_upload of these blocks),
+     * else own_lookup, built with the blocks (then lookup points into this
+     * struct: a built sl_lr_bezier is not copied). lookup_kind is its kind
+     * (kept for the #defines after the model is gone). */
+    const sl_lr_lookup *lookup;
+    sl_lr_lookup own_lookup;
+    sl_lr_lookup_kind lookup_kind;
 } sl_lr_bezier;
 
 /* Bernstein coefficients beta[0..order-1] of the piece of the univariate
@@ -61,9 +70,10 @@ typedef struct sl_lr_bezier {
  * must hold [a, b]); all 0 when none does. */
 void sl_lr_bernstein_piece(const double *t, int order, double a, double b, double *beta);
 
-/* Converts every element of a finished model and builds the element look-up
+/* Converts every element of a finished model and takes the element look-up
  * of the given kind (SL_LR_LOOKUP_AUTO: the texture where the knots allow,
- * else the k-d forest; forest_axis 0: the default). SL_ERR_NOMEM,
+ * else the k-d forest; forest_axis 0: the default) from the model's index
+ * when that is the same structure, else builds it. SL_ERR_NOMEM,
  * SL_ERR_LIMIT (blocks above 2^31 floats: the GPU buffers' index range), the
  * look-up's refusals (an octree on non-dyadic knots, ...). */
 sl_status sl_lr_bezier_build(const sl_lr_volume *lr, sl_lr_lookup_kind lookup, int forest_axis,
@@ -100,8 +110,8 @@ void sl_lr_bezier_release(sl_lr_bezier_gpu *gpu);
  * orders, dim, LR_DOUBLE (want_double) and LR_LOOKUP_KIND. Writes at most
  * size bytes. */
 void sl_lr_bezier_defines(const sl_lr_bezier *bz, int want_double, char *out, size_t size);
-/* Sets the uniforms of lr_bezier.glsl and the look-up (element count,
- * domain box) on `program` (which must be current). */
+/* Sets the uniforms of lr_bezier.glsl (element count, the domain box
+ * computed once by sl_lr_bezier_build) on `program` (which must be current). */
 void sl_lr_bezier_set_uniforms(unsigned program, const sl_lr_bezier *bz);
 
 /* Stage files include "lrspline/lr_find.glsl", which pastes lr_bezier.glsl

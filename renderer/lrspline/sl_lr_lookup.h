@@ -130,6 +130,15 @@ void sl_lr_lookup_deinit(sl_lr_lookup *lk);
 /* The element containing p (element rule), -1 outside or for NaN. */
 long sl_lr_lookup_find(const sl_lr_lookup *lk, const double p[3]);
 
+/* The look-up the model carries (sl_lr_index: always the `auto` build) when
+ * it is exactly what sl_lr_lookup_init(kind, forest_axis) would build on
+ * lr: kind auto; texture when the index is the texture; kdforest with
+ * forest_axis 0 or the default when the index fell back to the default
+ * forest. NULL otherwise (no index, or another structure): build one.
+ * Lets the GPU blocks reuse the index instead of building it twice
+ * (lr_index.c). */
+const sl_lr_lookup *sl_lr_index_match(const sl_lr_volume *lr, sl_lr_lookup_kind kind, int forest_axis);
+
 /* ---- GPU form (lr_lookup_gpu.c, lr_lookup.glsl) ----
  *
  * Three std430 SSBOs of 32-bit words, bound to fixed points:

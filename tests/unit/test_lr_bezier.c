@@ -12,7 +12,9 @@
  * elements with different basis lists; sl_lr_finish checks the partition
  * of unity). Also: the per-element hull bounds every value sampled in it;
  * the univariate Bernstein coefficients of the uniform quadratic B-spline
- * match the hand values.
+ * match the hand values; the blocks reuse the model's look-up only when it is
+ * the structure asked for (auto, the default forest), and their float domain
+ * box is the union of the element boxes.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -20,6 +22,7 @@
 
 #include "lrspline/sl_lr.h"
 #include "lrspline/sl_lr_bezier.h"
+#include "lrspline/sl_lr_lookup.h"
 #include "lr_test_models.h"
 #include "sl_test.h"
 
@@ -152,9 +155,65 @@ static void test_bernstein_hand(void)
     SL_CHECK(beta[0] == 0.0 && beta[1] == 0.0 && beta[2] == 0.0);
 }
 
+/* The blocks take the model's index when it is the structure asked for
+ * (auto; the texture; the default forest) and build their own otherwise;
+ * the domain box the GPU uniforms use is the float union of the element
+ * boxes. Two models: the hand-refined one (knots on a 0.5 grid: the index is
+ * the texture) and an uneven tensor product (the index is the forest). */
+static void check_lookup_reuse(sl_lr_volume *lr, sl_lr_lookup_kind index_kind)
+{
+    sl_err err;
+    sl_lr_bezier bz;
+    /* No index yet: built. */
+    SL_CHECK(lr->index == NULL);
+    SL_CHECK(sl_lr_bezier_build(lr, SL_LR_LOOKUP_AUTO, 0, &bz, &err) == SL_OK);
+    SL_CHECK(bz.lookup == &bz.own_lookup && bz.lookup_kind == index_kind);
+    for (int d = 0; d < 3; d++)
+        SL_CHECK(bz.domain_lo[d] == (float)lr->domain_lo[d] && bz.domain_hi[d] == (float)lr->domain_hi[d]);
+    sl_lr_bezier_free(&bz);
+    SL_CHECK(sl_lr_index(lr, &err) == SL_OK);
+    SL_CHECK(lr->index && lr->index->kind == index_kind);
+    int texture = index_kind == SL_LR_LOOKUP_TEXTURE;
+    const struct { sl_lr_lookup_kind kind; int axis, reused; } cases[] = {
+        {SL_LR_LOOKUP_AUTO, 0, 1}, {SL_LR_LOOKUP_AUTO, 8, 1}, {SL_LR_LOOKUP_TEXTURE, 0, texture},
+        {SL_LR_LOOKUP_KDFOREST, 0, !texture}, {SL_LR_LOOKUP_KDFOREST, SL_LR_FOREST_DEFAULT_AXIS, !texture},
+        {SL_LR_LOOKUP_KDFOREST, 4, 0}, {SL_LR_LOOKUP_KDTREE, 0, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        sl_status st = sl_lr_bezier_build(lr, cases[i].kind, cases[i].axis, &bz, &err);
+        if (cases[i].kind == SL_LR_LOOKUP_TEXTURE && !texture) { /* refused by the builder, not taken from the index */
+            SL_CHECK(st == SL_ERR_UNSUPPORTED);
+            continue;
+        }
+        SL_CHECK_MSG(st == SL_OK, "case %zu: %s", i, err.message);
+        if (st != SL_OK)
+            continue;
+        SL_CHECK_MSG((bz.lookup == lr->index) == cases[i].reused, "case %zu: index %s", i,
+                     cases[i].reused ? "not reused" : "reused for another structure");
+        SL_CHECK(bz.lookup_kind == bz.lookup->kind);
+        sl_lr_bezier_free(&bz);
+    }
+}
+
+static void test_lookup_reuse(void)
+{
+    sl_lr_volume lr;
+    memset(&lr, 0, sizeof lr);
+    SL_CHECK(lr_test_refined(&lr, 1, 0));
+    if (lr.element_count)
+        check_lookup_reuse(&lr, SL_LR_LOOKUP_TEXTURE);
+    sl_lr_free(&lr);
+    memset(&lr, 0, sizeof lr);
+    SL_CHECK(lr_test_tensor(&lr, 3, 3, 3, 1, 0));
+    if (lr.element_count)
+        check_lookup_reuse(&lr, SL_LR_LOOKUP_KDFOREST);
+    sl_lr_free(&lr);
+}
+
 int main(void)
 {
     test_bernstein_hand();
+    test_lookup_reuse();
     test_tensor(2, 2, 2, 1);
     test_tensor(3, 3, 3, 1);
     test_tensor(4, 4, 4, 1);
