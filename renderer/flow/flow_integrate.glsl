@@ -4,9 +4,8 @@
 // reasons). Expects REAL, VEC3, flow_finite3 (flow_real.glsl) and field()
 // / field_m() / field_d() / flow_local_size() before it. The tableau and the step mode are
 // uniforms (so one program per precision, and shaders-check compiles it
-// without defines). Difference from the CPU: the
-// step factor (tol/err)^(1/(q+1)) is root_n (float pow refined by Newton in
-// double), so a double step size may differ from libm's pow by an ulp.
+// without defines). The step factor's root is root_n, the CPU's
+// sl_flow_step_root operation for operation, so double steps are the CPU's.
 // Inexact constants are written as double literals (0.9lf), so double
 // variants use the same numbers as the C code.
 // Output per sample: 8 REAL (t, x, y, z, vx, vy, vz, 0) at
@@ -98,19 +97,27 @@ int rk_step(VEC3 x, VEC3 k0, REAL h, out VEC3 xn, out REAL err_norm)
     return inside(xn) ? 0 : -1;
 }
 
-// r^(1/n) for r in [1e-10, 1e10]: float pow, refined in double by three
-// Newton steps on y^n = r (GLSL has no double pow), so the step factor
-// agrees with the CPU's libm pow to about an ulp.
+// r^(1/n) for r in [1e-10, 1e10]: sl_flow_step_root of flow_trace.c, the
+// same operations in the same order (exponent reduction by frexp, 12 Newton
+// rounds on y^n = m from y = 2, ldexp back), so double gives the CPU's bits.
 REAL root_n(REAL r, int n)
 {
-    REAL y = REAL(pow(float(r), 1.0 / float(n)));
-#if SL_PREC != 0
-    for (int it = 0; it < 3; it++) {
-        REAL y1 = n == 2 ? y : n == 3 ? y * y : n == 4 ? y * y * y : (y * y) * (y * y);
-        y = y - (y1 * y - r) / (REAL(n) * y1);
+    if (n <= 1)
+        return r;
+    if (n == 2)
+        return sqrt(r);
+    int e;
+    REAL m = frexp(r, e);
+    int k = e >= 0 ? e / n : -((n - 1 - e) / n);
+    m = ldexp(m, e - n * k);
+    REAL y = REAL(2);
+    for (int it = 0; it < 12; it++) {
+        REAL y1 = y;
+        for (int j = 2; j < n; j++)
+            y1 = y1 * y;
+        y = y - (y1 * y - m) / (REAL(n) * y1);
     }
-#endif
-    return y;
+    return ldexp(y, k);
 }
 
 // Time along v from x to the first face (coordinate set exactly); -1: v = 0.

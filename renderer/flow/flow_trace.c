@@ -59,6 +59,26 @@ sl_status sl_flow_options_check(const sl_flow_options *o, sl_err *err)
     return SL_OK;
 }
 
+double sl_flow_step_root(double r, int n)
+{
+    if (n <= 1)
+        return r;
+    if (n == 2)
+        return sqrt(r);
+    int e;
+    double m = frexp(r, &e);             /* r = m 2^e, m in [0.5, 1) */
+    int k = e >= 0 ? e / n : -((n - 1 - e) / n); /* floor(e / n) */
+    m = ldexp(m, e - n * k);             /* in [0.5, 2^(n-1)) */
+    double y = 2.0;                      /* above every root of such m */
+    for (int it = 0; it < 12; it++) {
+        double y1 = y;
+        for (int j = 2; j < n; j++)
+            y1 = y1 * y;                 /* y^(n-1) */
+        y = y - (y1 * y - m) / ((double)n * y1);
+    }
+    return ldexp(y, k);
+}
+
 static int finite3(const double v[3])
 {
     return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
@@ -255,7 +275,7 @@ static int trace_line(const sl_flow_field *f, const double seed[3], const sl_flo
                 break;
             double ratio = e > 0.0 ? o->tol / e : 1e10;
             ratio = ratio < 1e-10 ? 1e-10 : ratio > 1e10 ? 1e10 : ratio; /* fac is clamped below anyway */
-            double fac = e > 0.0 ? 0.9 * pow(ratio, 1.0 / (double)(m->embedded_order + 1)) : 5.0;
+            double fac = e > 0.0 ? 0.9 * sl_flow_step_root(ratio, m->embedded_order + 1) : 5.0;
             if (fac < 0.2)
                 fac = 0.2;
             if (fac > 5.0)

@@ -143,7 +143,8 @@ const char *sl_flow_stop_name(sl_flow_stop s);
  * Adaptive step control (he, bs, rkf45): err = |x_high - x_low|_2 (absolute,
  * world units, the Euclidean norm of the difference of the two solutions);
  * a step is accepted when err <= tol; either way the next step is
- * h * clamp(0.9 (tol / err)^(1 / (embedded_order + 1)), 0.2, 5), then
+ * h * clamp(0.9 (tol / err)^(1 / (embedded_order + 1)), 0.2, 5) (the root
+ * by sl_flow_step_root, tol / err clamped to [1e-10, 1e10]), then
  * clamped to [h_min, h_max]; a step already at h_min is accepted whatever
  * err (counted in `forced`), so the trace always advances. The first step is
  * `step` when given, else min(h_max, tol^(1/(q+1))) with q the embedded order.
@@ -163,6 +164,18 @@ typedef struct sl_flow_options {
     size_t max_samples;           /* per line, seed included; 0 = 10000 */
     double min_speed;             /* stop below; 0 = 1e-300 */
 } sl_flow_options;
+
+/* r^(1/n) for r in [1e-10, 1e10] and n in 1..8, as the step control takes
+ * it: n = 1 r, n = 2 sqrt(r), else r = m 2^(n k) with m in [2^-1, 2^(n-1))
+ * (frexp), Newton's iteration on y^n = m from y = 2 for 12 rounds, times
+ * 2^k. Only operations IEEE 754 rounds exactly (+ - * / sqrt, exponent
+ * scaling), in a fixed order, so flow_integrate.glsl's root_n gives the
+ * same bits in double on the GPU. libm's pow(r, 1.0 / 3) did not: its
+ * exponent is not 1/3, and a Newton root from a float pow seed differs by
+ * an ulp or two, which the cancellation in the error estimate amplified
+ * into different step sequences (test_flow_gpu). Within 1 ulp of the
+ * true root (measured for n = 1..8 over the range; test_flow bounds it). */
+double sl_flow_step_root(double r, int n);
 
 /* Checks the options against a field (solver vs mode, positive step / tol /
  * t_max, finite values): SL_ERR_INVALID with a sentence. */

@@ -14,7 +14,8 @@
  * reproduces linear fields) and as degree-1 and degree-2 LR-splines
  * (sl_lr_tensor_product; Greville coefficients reproduce linear fields)
  * gives the analytic field's streamlines to 1e-9 (adaptive: step choices may differ by rounding). Seeds, Eq. 7, and the
- * line set conversion.
+ * line set conversion. The step control's root (sl_flow_step_root) within 1
+ * ulp of r^(1/n).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -381,8 +382,27 @@ static void test_seeds_and_metric(void)
     SL_CHECK_NEAR(sl_flow_line_error(&y, &ref, NULL, NULL, 0), 1e-3, 1e-12);
 }
 
+/* The step control's root against pow in long double: within 1 ulp (plus
+ * the long double's own rounding) for n = 1..8 over [1e-10, 1e10]. */
+static void test_step_root(void)
+{
+    for (int n = 1; n <= 8; n++) {
+        double worst = 0;
+        for (int i = 0; i <= 20000; i++) {
+            double r = pow(10.0, -10.0 + 20.0 * i / 20000.0);
+            long double t = powl((long double)r, 1.0L / n);
+            double y = sl_flow_step_root(r, n), ulp = nextafter((double)t, INFINITY) - (double)t;
+            double e = (double)(fabsl((long double)y - t) / ulp);
+            worst = e > worst ? e : worst;
+        }
+        SL_CHECK_MSG(worst <= 1.0, "sl_flow_step_root n = %d: %.3g ulp from the root", n, worst);
+    }
+    SL_CHECK(sl_flow_step_root(1e-10, 5) > 0 && sl_flow_step_root(32.0, 5) == 2.0 && sl_flow_step_root(0.25, 2) == 0.5);
+}
+
 int main(void)
 {
+    test_step_root();
     test_orders();
     test_adaptive();
     test_boundary_and_degenerate();
