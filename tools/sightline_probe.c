@@ -13,9 +13,14 @@
  * value (and gradient) fields: "x,y,z,," — so it is told apart from a NaN
  * voxel, which prints as nan.
  * Evaluation: renderer/probe/sl_probe.h on the CPU in double (trilinear,
- * spline). Points go to the evaluator in batches (probe_backend), so a GPU
- * backend of the same shape can be added as an option. Single-threaded.
- * Exit status: 0 success; 1 usage error; 2 bad input (message on stderr).
+ * spline); with --gpu, renderer/probe/sl_probe_gpu.h through the shaders the
+ * renderers sample with (LR: Bézier blocks in float, value and gradient;
+ * volumes: volume_dvr's filtered texture; vector fields: the streamline
+ * field; no gradients of regular volumes), the same points left empty.
+ * Points go to the evaluator in batches of BATCH. Single-threaded (the
+ * main thread owns the GL context).
+ * Exit status: 0 success; 1 usage error; 2 bad input (message on stderr);
+ * 3 no GPU or a GPU error (--gpu).
  */
 #include <errno.h>
 #include <math.h>
@@ -25,21 +30,24 @@
 
 #include "data/sl_dataset.h"
 #include "data/sl_dataset_open.h"
+#include "gpu/sl_gpu.h"
 #include "probe/sl_probe.h"
+#include "probe/sl_probe_gpu.h"
 
 #define EXIT_USAGE 1
 #define EXIT_BAD_INPUT 2
+#define EXIT_GPU 3
 #define BATCH 4096
 #define LINE_MAX_BYTES 4096
 
 /* Evaluates n points (3n doubles): values[n*nc], gradients[n*3*nc] (NULL:
- * none), inside[n]. The CPU backend below; a GPU one would take its place. */
-typedef sl_status (*probe_backend)(const sl_dataset *ds, size_t n, const double *points, double *values,
-                                   double *gradients, unsigned char *inside, sl_err *err);
-
-static sl_status probe_cpu(const sl_dataset *ds, size_t n, const double *points, double *values, double *gradients,
-                           unsigned char *inside, sl_err *err)
+ * none), inside[n]; through the shaders when gpu is not NULL, else on the
+ * CPU in double. */
+static sl_status evaluate(const sl_dataset *ds, sl_probe_gpu *gpu, size_t n, const double *points, double *values,
+                          double *gradients, unsigned char *inside, sl_err *err)
 {
+    if (gpu)
+        return sl_probe_gpu_eval(gpu, n, points, values, gradients, inside, err);
     int nc = sl_probe_components(ds);
     for (size_t i = 0; i < n; i++) {
         int in = 0;
@@ -54,11 +62,14 @@ static sl_status probe_cpu(const sl_dataset *ds, size_t n, const double *points,
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: sightline-probe DATASET --points P.csv [--gradient] [--out F.csv]\n"
+    fprintf(f, "usage: sightline-probe DATASET --points P.csv [--gradient] [--gpu] [--out F.csv]\n"
                "Evaluates the dataset's field (trilinear for volumes and vector fields, the spline for\n"
                "LR-spline volumes; double precision on the CPU) at the points x,y,z of P.csv and writes\n"
                "x,y,z,value... as CSV ('#' comments and a header line allowed in P.csv). Points outside\n"
-               "the domain get empty value fields. Exit 0 ok, 1 usage, 2 bad input.\n");
+               "the domain get empty value fields. --gpu: through the renderers' shaders instead (float;\n"
+               "LR: the Bezier blocks; volumes: volume_dvr's filtered texture; vector fields: the\n"
+               "streamline field; --gradient only for LR volumes). Exit 0 ok, 1 usage, 2 bad input,\n"
+               "3 no GPU or a GPU error.\n");
 }
 
 /* Parses one CSV field as a finite double; 0 when it is not one. */
@@ -150,7 +161,7 @@ static void write_rows(const probe_out *o, size_t n, const double *pts, const do
 }
 
 /* Reads the points file, evaluating and writing in batches. */
-static int run(const sl_dataset *ds, const char *points_path, FILE *in, const probe_out *o, probe_backend backend)
+static int run(const sl_dataset *ds, const char *points_path, FILE *in, const probe_out *o, sl_probe_gpu *gpu)
 {
     static double pts[3 * BATCH], val[SL_PROBE_MAX_COMPONENTS * BATCH], grad[9 * BATCH];
     static unsigned char inside[BATCH];
@@ -197,9 +208,10 @@ static int run(const sl_dataset *ds, const char *points_path, FILE *in, const pr
             n++;
         }
         if (n == BATCH || (eof && n > 0)) {
-            if (backend(ds, n, pts, val, o->gradient ? grad : NULL, inside, &err) != SL_OK) {
+            sl_status st = evaluate(ds, gpu, n, pts, val, o->gradient ? grad : NULL, inside, &err);
+            if (st != SL_OK) {
                 fprintf(stderr, "sightline-probe: %s\n", err.message);
-                return EXIT_BAD_INPUT;
+                return st == SL_ERR_GPU ? EXIT_GPU : EXIT_BAD_INPUT;
             }
             write_rows(o, n, pts, val, grad, inside);
             n = 0;
@@ -217,7 +229,7 @@ static int run(const sl_dataset *ds, const char *points_path, FILE *in, const pr
 int main(int argc, char **argv)
 {
     const char *source = NULL, *points = NULL, *out_path = NULL;
-    int gradient = 0;
+    int gradient = 0, use_gpu = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
             usage(stdout);
@@ -228,6 +240,8 @@ int main(int argc, char **argv)
             out_path = argv[++i];
         } else if (strcmp(argv[i], "--gradient") == 0) {
             gradient = 1;
+        } else if (strcmp(argv[i], "--gpu") == 0) {
+            use_gpu = 1;
         } else if (argv[i][0] == '-' && argv[i][1] == '-') {
             fprintf(stderr, "sightline-probe: unknown option or missing value: %s\n", argv[i]);
             usage(stderr);
@@ -252,11 +266,26 @@ int main(int argc, char **argv)
     }
     int rc = EXIT_BAD_INPUT;
     FILE *in = NULL, *out = NULL;
+    sl_gpu *gpu = NULL;
+    sl_probe_gpu *probe = NULL;
     probe_out o = {.nc = sl_probe_components(ds), .gradient = gradient};
     if (o.nc == 0) {
         fprintf(stderr, "sightline-probe: %s is a %s dataset: it has no field to probe (volumes, vector fields"
                         " and LR-spline volumes do)\n", source, sl_dataset_kind_name(ds->kind));
         goto done;
+    }
+    if (use_gpu) {
+        if (sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &gpu, &err) != SL_OK) {
+            fprintf(stderr, "sightline-probe: --gpu: %s\n", err.message);
+            rc = EXIT_GPU;
+            goto done;
+        }
+        sl_status st = sl_probe_gpu_create(ds, gradient, &probe, &err);
+        if (st != SL_OK) {
+            fprintf(stderr, "sightline-probe: %s\n", err.message);
+            rc = st == SL_ERR_UNSUPPORTED ? EXIT_BAD_INPUT : EXIT_GPU;
+            goto done;
+        }
     }
     in = strcmp(points, "-") == 0 ? stdin : fopen(points, "r");
     if (!in) {
@@ -269,7 +298,7 @@ int main(int argc, char **argv)
         goto done;
     }
     o.f = out;
-    rc = run(ds, points, in, &o, probe_cpu);
+    rc = run(ds, points, in, &o, probe);
     if (fflush(out) != 0 || ferror(out)) {
         fprintf(stderr, "sightline-probe: write error on %s\n", out_path ? out_path : "stdout");
         rc = EXIT_BAD_INPUT;
@@ -281,6 +310,8 @@ done:
         fprintf(stderr, "sightline-probe: write error on %s\n", out_path);
         rc = EXIT_BAD_INPUT;
     }
+    sl_probe_gpu_destroy(probe);
+    sl_gpu_destroy(gpu);
     sl_dataset_destroy(ds);
     return rc;
 }

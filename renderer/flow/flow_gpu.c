@@ -1,5 +1,5 @@
 /* flow_gpu.c — the compute-shader streamline driver (flow_gpu.h): field
- * texture (regular) or Bézier blocks and element look-up (LR, built and
+ * texture (regular, flow_field_gpu.c) or Bézier blocks and element look-up (LR, built and
  * uploaded once in create, bound per trace), one program per precision, the tableau of sl_flow_methods as
  * uniforms (doubles for mixed / double, so both paths run the same
  * coefficients; b - e subtracted here), seed / sample / info buffers,
@@ -87,30 +87,7 @@ sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the GPU streamline state");
     g->field = *f;
     g->has_double = has_doubles();
-    size_t n = (size_t)f->dims[0] * (size_t)f->dims[1] * (size_t)f->dims[2];
-    float *rgba = malloc(4 * n * sizeof *rgba);
-    if (!rgba) {
-        free(g);
-        return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the field texture");
-    }
-    const float *src = f->volume->data;
-    for (size_t i = 0; i < n; i++) {
-        rgba[4 * i] = src[3 * i];
-        rgba[4 * i + 1] = src[3 * i + 1];
-        rgba[4 * i + 2] = src[3 * i + 2];
-        rgba[4 * i + 3] = 0.0f;
-    }
-    sl_gl_check_errors("before the flow field upload", err);
-    glGenTextures(1, &g->texture);
-    glBindTexture(GL_TEXTURE_3D, g->texture);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA32F, f->dims[0], f->dims[1], f->dims[2], 0, GL_RGBA,
-                 GL_FLOAT, rgba);
-    glBindTexture(GL_TEXTURE_3D, 0);
-    free(rgba);
-    sl_status st = sl_gl_check_errors("uploading the flow field texture", err);
+    sl_status st = sl_flow_field_texture_create(f, &g->texture, err);
     if (st != SL_OK) {
         sl_flow_gpu_destroy(g);
         return st;
@@ -271,18 +248,7 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
         sl_lr_bezier_set_uniforms(program, &g->bz);
         sl_lr_bezier_bind(&g->blocks, program);
     } else {
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_3D, g->texture);
-        glUniform1i(glGetUniformLocation(program, "u_field"), 0);
-        glUniform3i(glGetUniformLocation(program, "u_dims"), f->dims[0], f->dims[1], f->dims[2]);
-        glUniform3f(glGetUniformLocation(program, "u_origin_f"), (float)f->origin[0], (float)f->origin[1],
-                    (float)f->origin[2]);
-        glUniform3f(glGetUniformLocation(program, "u_spacing_f"), (float)f->spacing[0], (float)f->spacing[1],
-                    (float)f->spacing[2]);
-    }
-    if (!g->has_lr && precision != SL_FLOW_SINGLE) {
-        glUniform3d(glGetUniformLocation(program, "u_origin_d"), f->origin[0], f->origin[1], f->origin[2]);
-        glUniform3d(glGetUniformLocation(program, "u_spacing_d"), f->spacing[0], f->spacing[1], f->spacing[2]);
+        sl_flow_field_texture_bind(program, f, g->texture, precision != SL_FLOW_SINGLE);
     }
     set_tableau(program, m, dbl);
     glUniform1i(glGetUniformLocation(program, "u_mode"), (int)o->mode);

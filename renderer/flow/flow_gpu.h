@@ -36,6 +36,17 @@ const char *sl_flow_precision_name(sl_flow_precision p);
 
 typedef struct sl_flow_gpu sl_flow_gpu;
 
+/* A regular vector field as flow_field_regular.glsl reads it
+ * (flow_field_gpu.c, also used by sightline-probe --gpu): its voxels as an
+ * RGBA32F 3D texture (nearest; the shader interpolates). SL_ERR_UNSUPPORTED
+ * for other field kinds, SL_ERR_NOMEM, SL_ERR_GPU; on failure *texture is 0.
+ * The caller deletes the texture (glDeleteTextures). */
+sl_status sl_flow_field_texture_create(const sl_flow_field *f, GLuint *texture, sl_err *err);
+/* Binds the texture to unit 0 and sets u_field, u_dims, u_origin_f,
+ * u_spacing_f (and with doubles u_origin_d, u_spacing_d) on `program`,
+ * which must be current. */
+void sl_flow_field_texture_bind(GLuint program, const sl_flow_field *f, GLuint texture, int doubles);
+
 /* Uploads the field (LR: builds the Bézier blocks and the look-up, then
  * uploads them). SL_ERR_UNSUPPORTED for analytic fields and LR models not
  * of dim 3 (the message says which), the block build's errors

@@ -17,13 +17,15 @@ int sl_probe_components(const sl_dataset *ds)
     }
 }
 
-/* Trilinear value and gradient of a regular volume at world point p. */
-static int probe_volume(const sl_dataset *ds, const double p[3], double *value, double *gradient)
+/* The cell of a regular volume around world point p: per axis the voxels
+ * lo..hi, the local weight t and whether the axis varies (live); 0 when p is
+ * outside the domain (the closed box of the voxel centres; a one-voxel
+ * axis: a slab one spacing thick). */
+static int volume_cell(const sl_dataset *ds, const double p[3], size_t lo[3], size_t hi[3], double t[3],
+                       double live[3])
 {
     const sl_volume *vol = &ds->volume;
     const double origin[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
-    size_t lo[3], hi[3];
-    double t[3], live[3];
     for (int a = 0; a < 3; a++) {
         double u = (p[a] - origin[a]) / vol->spacing[a]; /* voxel coordinate */
         int n = vol->dims[a];
@@ -45,6 +47,17 @@ static int probe_volume(const sl_dataset *ds, const double p[3], double *value, 
         t[a] = u - cell;
         live[a] = 1.0;
     }
+    return 1;
+}
+
+/* Trilinear value and gradient of a regular volume at world point p. */
+static int probe_volume(const sl_dataset *ds, const double p[3], double *value, double *gradient)
+{
+    const sl_volume *vol = &ds->volume;
+    size_t lo[3], hi[3];
+    double t[3], live[3];
+    if (!volume_cell(ds, p, lo, hi, t, live))
+        return 0;
     int nc = vol->components;
     for (int c = 0; c < nc; c++) {
         double f = 0.0, g[3] = {0.0, 0.0, 0.0};
@@ -71,6 +84,17 @@ static int probe_volume(const sl_dataset *ds, const double p[3], double *value, 
                 gradient[c * 3 + a] = g[a] / vol->spacing[a];
     }
     return 1;
+}
+
+int sl_probe_inside(const sl_dataset *ds, const double p[3])
+{
+    if (sl_probe_components(ds) == 0 || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+        return 0;
+    if (ds->kind == SL_DATASET_LR)
+        return sl_lr_find_element(ds->lr, p) >= 0;
+    size_t lo[3], hi[3];
+    double t[3], live[3];
+    return volume_cell(ds, p, lo, hi, t, live);
 }
 
 sl_status sl_probe_eval(const sl_dataset *ds, const double p[3], double *value, double *gradient, int *inside,

@@ -10,8 +10,7 @@
  * one-voxel axis); taps of zero weight are not read (a NaN neighbour does not
  * reach a probe on a voxel). LR-spline volumes: sl_lr_eval on the element the
  * rule of lrspline/sl_lr.h picks (sl_lr_find_element: the model's look-up). Line sets have no field.
- * No GPU path here (tools/sightline_probe.c has the backend seam for one).
- * Any thread; the dataset is only read.
+ * The shader path is sl_probe_gpu.h. Any thread; the dataset is only read.
  */
 #ifndef SL_PROBE_H
 #define SL_PROBE_H
@@ -24,6 +23,12 @@
 /* Value components of the dataset's field: 1 (scalar) or 3 (vector); 0 for
  * datasets without a field (line sets). */
 int sl_probe_components(const sl_dataset *ds);
+
+/* 1 when p is finite and inside the dataset's domain (the rule above:
+ * the voxel centres' closed box, the LR element rule), else 0 (also for
+ * datasets without a field). What decides "outside" for sl_probe_eval and
+ * for the GPU path (sl_probe_gpu.h) alike. */
+int sl_probe_inside(const sl_dataset *ds, const double p[3]);
 
 /* Evaluates the field at the world point p. Inside the domain: *inside = 1,
  * value[components] and, when gradient is not NULL, gradient[c*3 + j] =

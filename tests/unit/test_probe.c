@@ -9,7 +9,10 @@
  * coefficients reproduce f = x + 2y - z exactly, to 1e-12 in value and
  * (1, 2, -1) in gradient. Also: the domain edges (closed upper face, a
  * one-voxel slab, outside -> empty CSV fields), a NaN neighbour, a line
- * set refused, bad CSV lines refused with their line number.
+ * set refused, bad CSV lines refused with their line number. The tool's
+ * --gpu against its CPU path on the files of tests/data/lr/ (with
+ * gradients) and marschner_lobb (values): the same rows and empty fields,
+ * within 1e-5 of the value range; --gpu --gradient on a volume exits 2.
  */
 #include <math.h>
 #include <stdio.h>
@@ -388,6 +391,79 @@ static void test_tool_volume(void)
     sl_dataset_destroy(ref);
 }
 
+/* --gpu against the CPU path through the tool: the same rows, the same
+ * empty fields, values and gradients within 1e-5 (test_probe_gpu.c checks
+ * the library in depth). On the LR test files; a regular volume's values
+ * too, and its gradient on the GPU refused with exit 2. */
+static void compare_tool_gpu(const char *dataset, const char *pts_path, int cols, const char *opts, double bound)
+{
+    char cmd[2048];
+    char *out[2] = {NULL, NULL};
+    for (int k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd, "'%s/bin/sightline-probe' '%s' --points '%s' %s%s 2>&1", bin_dir(), dataset,
+                 pts_path, opts, k ? " --gpu" : "");
+        int rc = run(cmd, &out[k]);
+        SL_CHECK_MSG(rc == 0, "sightline-probe %s%s: exit %d: %.300s", dataset, k ? " --gpu" : "", rc,
+                     out[k] ? out[k] : "");
+    }
+    if (out[0] && out[1]) {
+        SL_CHECK_MSG(strcspn(out[0], "\n") == strcspn(out[1], "\n") &&
+                         strncmp(out[0], out[1], strcspn(out[0], "\n")) == 0, "%s: headers differ", dataset);
+        static double rows[2][256][16];
+        int empty[2][256];
+        int n0 = parse_rows(out[0], cols, rows[0], empty[0], 256), n1 = parse_rows(out[1], cols, rows[1], empty[1], 256);
+        SL_CHECK_MSG(n0 == n1 && n0 > 0, "%s: %d CPU rows, %d GPU rows", dataset, n0, n1);
+        double worst = 0.0;
+        int empties = 0, same = 1;
+        for (int i = 0; i < n0 && i < n1; i++) {
+            same &= empty[0][i] == empty[1][i] && rows[0][i][0] == rows[1][i][0] && rows[0][i][1] == rows[1][i][1] &&
+                    rows[0][i][2] == rows[1][i][2];
+            empties += empty[0][i];
+            for (int c = 3; c < cols && !empty[0][i]; c++)
+                worst = fmax(worst, fabs(rows[0][i][c] - rows[1][i][c]));
+        }
+        SL_CHECK_MSG(same, "%s: the points or their empty fields differ between the paths", dataset);
+        SL_CHECK_MSG(empties > 0, "%s: no point outside", dataset);
+        SL_CHECK_MSG(worst <= bound, "%s: --gpu differs by %.3g > %.0e", dataset, worst, bound);
+        printf("sightline-probe %s --gpu: max difference %.3g over %d rows (%d outside)\n", dataset, worst, n0,
+               empties);
+    }
+    free(out[0]);
+    free(out[1]);
+}
+
+static void test_tool_gpu(void)
+{
+    /* Points in [-0.25, 1.25]^3 on a 1/16 lattice (the knot planes of
+     * refined_quadratic), random ones, and some outside both files' domains. */
+    char csv[16384];
+    int n = 0;
+    for (int i = 0; i < 200; i++) {
+        double p[3];
+        for (int d = 0; d < 3; d++)
+            p[d] = i % 2 ? -0.25 + 1.5 * frand() : floor(frand() * 20.0 - 2.0) / 16.0;
+        n += snprintf(csv + n, sizeof csv - (size_t)n, "%.17g,%.17g,%.17g\n", p[0], p[1], p[2]);
+    }
+    const char *pts_path = tmp("gpts.csv");
+    write_all(pts_path, csv, (size_t)n);
+    const char *src = getenv("SIGHTLINE_SOURCE_DIR");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tests/data/lr/refined_quadratic.lr.gz", src ? src : ".");
+    compare_tool_gpu(path, pts_path, 15, "--gradient", 1e-5);  /* identity map: value range and Jacobian 1 */
+    snprintf(path, sizeof path, "%s/tests/data/lr/two_lines.lr", src ? src : ".");
+    compare_tool_gpu(path, pts_path, 7, "--gradient", 4e-5);   /* value range 4: 1e-5 of it */
+    /* marschner_lobb on [-1, 1]^3, values in [0, 1]: the points cover part of it. */
+    compare_tool_gpu("marschner_lobb", pts_path, 4, "", 1e-5);
+    char cmd[2048];
+    char *out = NULL;
+    snprintf(cmd, sizeof cmd, "'%s/bin/sightline-probe' marschner_lobb --points '%s' --gradient --gpu 2>&1 >/dev/null",
+             bin_dir(), pts_path);
+    int rc = run(cmd, &out);
+    SL_CHECK_MSG(rc == 2 && out && strstr(out, "gradient"), "--gpu --gradient on a volume: exit %d, %s", rc,
+                 out ? out : "");
+    free(out);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/sl_test_probe_XXXXXX");
@@ -401,8 +477,10 @@ int main(void)
     test_volume_edges();
     test_tool_lr();
     test_tool_volume();
-    const char *names[] = {"plane.lr", "points.csv", "bad.csv", "field.raw", "field.json", "vpts.csv", "vout.csv"};
-    for (int i = 0; i < 7; i++)
+    test_tool_gpu();
+    const char *names[] = {"plane.lr", "points.csv", "bad.csv", "field.raw", "field.json", "vpts.csv", "vout.csv",
+                           "gpts.csv"};
+    for (int i = 0; i < 8; i++)
         unlink(tmp(names[i]));
     rmdir(tmpdir);
     SL_TEST_END();
