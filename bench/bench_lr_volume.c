@@ -1,7 +1,7 @@
 /* bench_lr_volume.c — run time against image error of `lr_volume`: adaptive
  * step (min element side / 2^d, paper Eq. 4) against the uniform step.
  *
- *   bench-lr-volume [--small | --size WxH] [--frames N] [--error-size WxH]
+ *   bench-lr-volume [--small | --size WxH] [--frames N] [--error-size WxH] [--table steps|woodgrain|peer]
  *
  * Dataset: lr_field sphere, degree 2, 6 cells, grading 0.6 (element sides
  * varying 4x; 216 elements; k-d forest look-up). Fixed transfer function (points form),
@@ -16,8 +16,14 @@
  * through lr_volume, and the marschner_lobb voxels through volume_dvr (what a
  * user would otherwise pick), same camera, transfer function and step of
  * half a voxel (no jitter, no shading); ms per frame, their ratio and the
- * images' difference. --small for a quick table.
- * Prints Markdown; checks nothing (tests/unit/test_lr_volume.c does).
+ * images' difference. Wood-grain (third table): uniform 2 and 1, adaptive
+ * d = 0 and 1, each with samples at segment midpoints and with the
+ * per-pixel jitter (parameter `jitter`), the error of the whole frame at the
+ * bench size against uniform 1/32 without jitter at that size: mean, max and
+ * `band` (mean |8x8-block average of the signed difference|: the coherent
+ * error, rings, that noise of zero mean does not leave). --small for a quick
+ * run; --table for one table. Prints Markdown; checks nothing
+ * (tests/unit/test_lr_volume.c does).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,10 +31,12 @@
 
 #include <cjson/cJSON.h>
 
+#include "core/sl_clock.h"
 #include "core/sl_technique.h"
 #include "data/sl_generate.h"
 #include "gpu/sl_gpu.h"
 #include "harness/sl_bench.h"
+#include "image_error.h"
 #include "lrspline/sl_lr.h"
 #include "pipeline/sl_pipeline.h"
 #include "sl_params_json.h"
@@ -107,14 +115,7 @@ static sl_status peer_table(sl_gpu *gpu, const sl_bench_options *bo, int ew, int
         sl_pipeline_destroy(p);
     }
     if (st == SL_OK) {
-        double sum = 0;
-        int mx = 0;
-        for (size_t i = 0; i < n; i++)
-            for (int c = 0; c < 3; c++) {
-                int e = abs((int)img[0][4 * i + c] - (int)img[1][4 * i + c]);
-                sum += e;
-                mx = e > mx ? e : mx;
-            }
+        image_error ie = image_error_compare(img[0], img[1], ew, eh, 8);
         printf("\n## Peer: lr_volume on the trilinear-equivalent spline vs volume_dvr on the voxels\n\n"
                "marschner_lobb 41^3 both ways (lr_field trilinear_ml, 64000 elements), step 0.5 voxel, "
                "time at %dx%d, median of %d frames; images compared at %dx%d\n\n"
@@ -122,10 +123,125 @@ static sl_status peer_table(sl_gpu *gpu, const sl_bench_options *bo, int ew, int
                "| lr_volume | %.0f | %.1f |\n| volume_dvr | %.0f | %.1f |\n\n"
                "ratio lr_volume / volume_dvr: %.2f; images: mean dRGB %.3f, max %d\n",
                bo->width, bo->height, bo->frames, ew, eh, samples[0], ms[0], samples[1], ms[1],
-               ms[1] > 0 ? ms[0] / ms[1] : 0.0, sum / (3.0 * n), mx);
+               ms[1] > 0 ? ms[0] / ms[1] : 0.0, ie.mean, ie.max);
     }
     free(img[0]);
     free(img[1]);
+    return st;
+}
+
+/* Adaptive against uniform steps: error at ew x eh against uniform 1/32,
+ * time at the bench size. */
+static sl_status steps_table(sl_pipeline *p, const sl_technique *t, const sl_params *base, const sl_dataset *ds,
+                             const sl_bench_options *bo, int ew, int eh, sl_err *err)
+{
+    sl_view ev;
+    sl_status st = view_at(ds, ew, eh, &ev, err);
+    size_t n = (size_t)ew * eh;
+    uint8_t *ref = malloc(4 * n), *img = malloc(4 * n);
+    double samples = 0;
+    sl_params rp = *base;
+    if (st == SL_OK && (!ref || !img))
+        st = sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    if (st == SL_OK)
+        st = sl_bench_set_choice(&rp, "step_mode", "uniform", err);
+    if (st == SL_OK)
+        st = sl_bench_set(&rp, "step", 1.0 / 32.0, err);
+    if (st == SL_OK)
+        st = render_into(p, t, &rp, &ev, ref, &samples, err);
+    if (st == SL_OK) {
+        printf("## lr_volume: adaptive vs uniform step\n\n%s, %zu elements; error at %dx%d against uniform 1/32 "
+               "(%.0f samples); time at %dx%d, median of %d frames\n\n", DATASET, ds->lr->element_count, ew, eh,
+               samples, bo->width, bo->height, bo->frames);
+        printf("| step | samples (error frame) | mean dRGB | max dRGB | ms / frame |\n|---|---|---|---|---|\n");
+        fflush(stdout);
+    }
+    static const struct { const char *mode; double value; } rows[] = {
+        {"uniform", 2}, {"uniform", 1}, {"uniform", 0.5}, {"uniform", 0.25}, {"uniform", 0.125},
+        {"adaptive", 0}, {"adaptive", 1}, {"adaptive", 2}, {"adaptive", 3}, {"adaptive", 4},
+    };
+    for (size_t r = 0; r < sizeof rows / sizeof rows[0] && st == SL_OK; r++) {
+        sl_params q = *base;
+        st = sl_bench_set_choice(&q, "step_mode", rows[r].mode, err);
+        if (st == SL_OK)
+            st = sl_bench_set(&q, strcmp(rows[r].mode, "uniform") == 0 ? "step" : "step_depth", rows[r].value, err);
+        if (st == SL_OK)
+            st = render_into(p, t, &q, &ev, img, &samples, err);
+        sl_bench_timing tm;
+        if (st == SL_OK)
+            st = sl_bench_time_frames(p, t, &q, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit, &tm, err);
+        if (st != SL_OK)
+            break;
+        image_error ie = image_error_compare(img, ref, ew, eh, 8);
+        char label[48];
+        if (strcmp(rows[r].mode, "uniform") == 0)
+            snprintf(label, sizeof label, "uniform %g x min side", rows[r].value);
+        else
+            snprintf(label, sizeof label, "adaptive d = %g", rows[r].value);
+        printf("| %s | %.0f | %.3f | %d | %.1f |\n", label, samples, ie.mean, ie.max, tm.median_ms);
+        fflush(stdout);
+    }
+    free(ref);
+    free(img);
+    return st;
+}
+
+/* Wood-grain: the sample lattice at midpoints against the per-pixel jitter,
+ * same steps (so the same sample count up to the segments skipping moves),
+ * the error of the whole frame at the bench size against uniform 1/32
+ * without jitter, rendered at that size too. */
+static sl_status woodgrain_table(sl_pipeline *p, const sl_technique *t, const sl_params *base, const sl_dataset *ds,
+                                 const sl_bench_options *bo, sl_err *err)
+{
+    const int w = bo->width, h = bo->height;
+    size_t n = (size_t)w * (size_t)h;
+    uint8_t *ref = malloc(4 * n), *img = malloc(4 * n);
+    sl_view v;
+    double samples = 0;
+    sl_params rp = *base;
+    sl_status st = ref && img ? view_at(ds, w, h, &v, err) : sl_err_set(err, SL_ERR_NOMEM, "out of memory");
+    if (st == SL_OK)
+        st = sl_bench_set_choice(&rp, "step_mode", "uniform", err);
+    if (st == SL_OK)
+        st = sl_bench_set(&rp, "step", 1.0 / 32.0, err);
+    double t0 = sl_clock_ms();
+    if (st == SL_OK)
+        st = render_into(p, t, &rp, &v, ref, &samples, err);
+    if (st == SL_OK) {
+        printf("\n## lr_volume: wood-grain, samples at segment midpoints against per-pixel jitter\n\n"
+               "%s; the whole frame at %dx%d against uniform 1/32 without jitter (%.0f samples, %.0f ms); "
+               "band = mean |8x8-block average of the signed dRGB| (the coherent part: rings, not noise); "
+               "time at %dx%d, median of %d frames\n\n"
+               "| step | jitter | samples | mean dRGB | band dRGB | max dRGB | ms / frame |\n"
+               "|---|---|---|---|---|---|---|\n", DATASET, w, h, samples, sl_clock_ms() - t0, w, h, bo->frames);
+        fflush(stdout);
+    }
+    static const struct { const char *mode; double value; } rows[] = {
+        {"uniform", 2}, {"uniform", 1}, {"adaptive", 0}, {"adaptive", 1},
+    };
+    for (size_t r = 0; r < 2 * (sizeof rows / sizeof rows[0]) && st == SL_OK; r++) {
+        int jitter = (int)(r % 2);
+        sl_params q = *base;
+        const char *mode = rows[r / 2].mode;
+        st = sl_bench_set_choice(&q, "step_mode", mode, err);
+        if (st == SL_OK)
+            st = sl_bench_set(&q, strcmp(mode, "uniform") == 0 ? "step" : "step_depth", rows[r / 2].value, err);
+        if (st == SL_OK)
+            st = sl_bench_set(&q, "jitter", jitter, err);
+        if (st == SL_OK)
+            st = render_into(p, t, &q, &v, img, &samples, err);
+        sl_bench_timing tm;
+        if (st == SL_OK)
+            st = sl_bench_time_frames(p, t, &q, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit, &tm, err);
+        if (st != SL_OK)
+            break;
+        image_error ie = image_error_compare(img, ref, w, h, 8);
+        printf("| %s %g | %s | %.0f | %.3f | %.3f | %d | %.1f |\n", mode, rows[r / 2].value, jitter ? "on" : "off",
+               samples, ie.mean, ie.band, ie.max, tm.median_ms);
+        fflush(stdout);
+    }
+    free(ref);
+    free(img);
     return st;
 }
 
@@ -134,6 +250,7 @@ int main(int argc, char **argv)
     sl_bench_options bo;
     sl_bench_options_init(&bo, 4);
     int ew = 160, eh = 90;
+    const char *only = NULL;
     for (int i = 1; i < argc; i++) {
         int r = sl_bench_option(&bo, argc, argv, &i, "bench-lr-volume"); /* leaves i on its last word */
         if (r < 0)
@@ -145,7 +262,14 @@ int main(int argc, char **argv)
             i++;
             continue;
         }
-        fprintf(stderr, "usage: bench-lr-volume %s [--error-size WxH]\n", SL_BENCH_OPTIONS_HELP);
+        if (strcmp(argv[i], "--table") == 0 && i + 1 < argc &&
+            (strcmp(argv[i + 1], "steps") == 0 || strcmp(argv[i + 1], "woodgrain") == 0 ||
+             strcmp(argv[i + 1], "peer") == 0)) {
+            only = argv[++i];
+            continue;
+        }
+        fprintf(stderr, "usage: bench-lr-volume %s [--error-size WxH] [--table steps|woodgrain|peer]\n",
+                SL_BENCH_OPTIONS_HELP);
         return 1;
     }
     sl_err err = {0};
@@ -165,67 +289,14 @@ int main(int argc, char **argv)
     cJSON *patch = cJSON_Parse(BASE_PARAMS);
     sl_status st = patch ? sl_params_apply_json(&base, patch, &err) : SL_ERR_INVALID;
     cJSON_Delete(patch);
-    sl_view ev;
-    if (st == SL_OK)
-        st = view_at(ds, ew, eh, &ev, &err);
-    size_t n = (size_t)ew * eh;
-    uint8_t *ref = malloc(4 * n), *img = malloc(4 * n);
-    double samples = 0;
-    sl_params rp = base;
-    if (st == SL_OK && ref && img) {
-        st = sl_bench_set_choice(&rp, "step_mode", "uniform", &err);
-        if (st == SL_OK)
-            st = sl_bench_set(&rp, "step", 1.0 / 32.0, &err);
-        if (st == SL_OK)
-            st = render_into(p, t, &rp, &ev, ref, &samples, &err);
-    }
-    if (st != SL_OK || !ref || !img) {
-        fprintf(stderr, "bench-lr-volume: %s\n", err.message);
-        return 2;
-    }
-    printf("## lr_volume: adaptive vs uniform step\n\n%s, %zu elements; error at %dx%d against uniform 1/32 "
-           "(%.0f samples); time at %dx%d, median of %d frames\n\n", DATASET, ds->lr->element_count, ew, eh, samples,
-           bo.width, bo.height, bo.frames);
-    printf("| step | samples (error frame) | mean dRGB | max dRGB | ms / frame |\n|---|---|---|---|---|\n");
-    fflush(stdout);
-    static const struct { const char *mode; double value; } rows[] = {
-        {"uniform", 2}, {"uniform", 1}, {"uniform", 0.5}, {"uniform", 0.25}, {"uniform", 0.125},
-        {"adaptive", 0}, {"adaptive", 1}, {"adaptive", 2}, {"adaptive", 3}, {"adaptive", 4},
-    };
-    for (size_t r = 0; r < sizeof rows / sizeof rows[0] && st == SL_OK; r++) {
-        sl_params q = base;
-        st = sl_bench_set_choice(&q, "step_mode", rows[r].mode, &err);
-        if (st == SL_OK)
-            st = sl_bench_set(&q, strcmp(rows[r].mode, "uniform") == 0 ? "step" : "step_depth", rows[r].value, &err);
-        if (st == SL_OK)
-            st = render_into(p, t, &q, &ev, img, &samples, &err);
-        sl_bench_timing tm;
-        if (st == SL_OK)
-            st = sl_bench_time_frames(p, t, &q, &bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit, &tm, &err);
-        if (st != SL_OK)
-            break;
-        double sum = 0;
-        int mx = 0;
-        for (size_t i = 0; i < n; i++)
-            for (int c = 0; c < 3; c++) {
-                int e = abs((int)img[4 * i + c] - (int)ref[4 * i + c]);
-                sum += e;
-                mx = e > mx ? e : mx;
-            }
-        char label[48];
-        if (strcmp(rows[r].mode, "uniform") == 0)
-            snprintf(label, sizeof label, "uniform %g x min side", rows[r].value);
-        else
-            snprintf(label, sizeof label, "adaptive d = %g", rows[r].value);
-        printf("| %s | %.0f | %.3f | %d | %.1f |\n", label, samples, sum / (3.0 * n), mx, tm.median_ms);
-        fflush(stdout);
-    }
-    if (st == SL_OK)
+    if (st == SL_OK && (!only || strcmp(only, "steps") == 0))
+        st = steps_table(p, t, &base, ds, &bo, ew, eh, &err);
+    if (st == SL_OK && (!only || strcmp(only, "woodgrain") == 0))
+        st = woodgrain_table(p, t, &base, ds, &bo, &err);
+    if (st == SL_OK && (!only || strcmp(only, "peer") == 0))
         st = peer_table(gpu, &bo, ew, eh, &err);
     if (st != SL_OK)
         fprintf(stderr, "bench-lr-volume: %s\n", err.message);
-    free(ref);
-    free(img);
     sl_pipeline_destroy(p);
     sl_gpu_destroy(gpu);
     return st == SL_OK ? 0 : 2;

@@ -2,15 +2,17 @@
  * LR-spline volume (issue 15; Fuchs, Barrowclough, Hjelmervik, Dahl).
  *
  * prepare converts every element to its Bézier block (lrspline/lr_bezier.c)
- * and uploads the blocks and the element look-up (lr_bezier_gpu.c), and
+ * and uploads the blocks and the element look-up (lr_bezier_gpu.c; the
+ * dataset model's own index when it is the kind asked for), and
  * builds a proxy of the volume's values for the transfer function (value
  * range and histogram of a 48^3 lattice of exact values, so "auto" opacity
  * and colormap ranges resolve as for volume_dvr, through the shared
  * renderer/volume/ code). render: one full-screen pass of lr_volume.frag.glsl
  * (the model: README.md); the transfer function is baked into volume_dvr's
  * table and texture (re-baked only when it changes, with the per-element
- * visibility of the hulls). Every parameter is FRAME level. Scalar volumes,
- * and vector volumes (dim 3) by their magnitude. Render thread only.
+ * visibility of the hulls). Every parameter but lookup and forest_blocks is
+ * FRAME level. Scalar volumes, and vector volumes (dim 3) by their
+ * magnitude. Render thread only.
  */
 #include <math.h>
 #include <stdio.h>
@@ -24,6 +26,10 @@
 #include "../lrspline/sl_lr.h"
 #include "../lrspline/sl_lr_bezier.h"
 #include "../volume/sl_volume.h"
+
+/* On by default, as volume_dvr's: at equal samples it trades the rings of a
+ * coarse step for fine noise (README.md "Wood-grain", bench-lr-volume). */
+#define JITTER_DEFAULT 1
 
 static const char *const mode_names[] = {"composite", "mip", NULL};
 static const char *const step_mode_names[] = {"adaptive", "uniform", NULL};
@@ -48,6 +54,9 @@ static const sl_param_def lr_volume_params[] = {
     {"shading", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
      "composite: colour times max(0.4, |l.n|), n the exact unit gradient, l the view ray (paper)",
      SL_INVALIDATE_FRAME},
+    {"jitter", SL_PARAM_BOOL, 0, 1, {JITTER_DEFAULT}, NULL, "",
+     "sample each segment at a per-pixel offset (a fixed hash of the pixel, so frames repeat) instead of its "
+     "midpoint: wood-grain becomes fine noise at the same sample count", SL_INVALIDATE_FRAME},
     {"empty_space_skipping", SL_PARAM_BOOL, 0, 1, {1}, NULL, "",
      "jump over elements whose value hull (convex hull of the Bézier coefficients) cannot contribute (same image)",
      SL_INVALIDATE_FRAME},
@@ -294,6 +303,7 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
     glUniform1i(glGetUniformLocation(p, "u_shading"), sl_params_bool(params, "shading"));
     glUniform1i(glGetUniformLocation(p, "u_skipping"), sl_params_bool(params, "empty_space_skipping"));
     glUniform1i(glGetUniformLocation(p, "u_max_steps"), MAX_STEPS);
+    glUniform1i(glGetUniformLocation(p, "u_jitter"), sl_params_bool(params, "jitter"));
     glUniform2f(glGetUniformLocation(p, "u_tf_map"), (float)s->table->lo,
                 (float)((SL_VOLUME_TF_TEXELS - 1) / (s->table->hi - s->table->lo)));
     glUniform1i(glGetUniformLocation(p, "u_tf"), UNIT_TF);

@@ -13,7 +13,9 @@
 // from the CPU per transfer function), mip over elements whose hull maximum cannot raise
 // the running maximum. The element at a point is reused while the point stays in its box
 // (else lr_find_element). Skipping keeps the uniform lattice, so it changes no sample
-// there. Variants: LR_MODE 0 composite, 1 mip; lr_bezier.glsl's.
+// there. With u_jitter, every segment is sampled at the pixel's offset u in [0, 1) of it
+// (sl_volume_jitter of the pixel: the same per frame) instead of its midpoint, against
+// wood-grain. Variants: LR_MODE 0 composite, 1 mip; lr_bezier.glsl's.
 #include "gpu/glsl/camera.glsl"
 #include "lrspline/lr_find.glsl"
 #include "volume/volume_ray.glsl"
@@ -32,6 +34,7 @@ uniform float u_alpha_stop;
 uniform int u_shading;
 uniform int u_skipping;
 uniform int u_max_steps;       // guard against a stalled ray
+uniform int u_jitter;          // 1: sample at the pixel's offset in each segment, 0: at midpoints
 
 layout(std430, binding = 5) buffer lr_rows { uint lr_row_counts[]; };  // per row: taken, skipped
 layout(std430, binding = 4) readonly buffer lr_visible { uint lr_visible_data[]; }; // per element: 1 visible
@@ -60,6 +63,7 @@ void main()
     float vmax = -1.0 / 0.0;
     bool any = false;
 #endif
+    float off = u_jitter != 0 ? sl_volume_jitter(gl_FragCoord.xy) : 0.5; // sample position in a segment
     float t = t0;
     int ks = 0;                // uniform: segments so far (t = t0 + ks dt, no accumulated rounding)
     int e = -1;
@@ -82,9 +86,9 @@ void main()
             bool skip = lr_box_data[e].hi.w <= vmax;
 #endif
             float texit = min(sl_volume_ray_box(eye, inv_d, elo, ehi).y, t1);
-            // Uniform: the segments whose midpoints lie before the exit (the lattice and the
+            // Uniform: the segments whose samples lie before the exit (the lattice and the
             // samples stay those without skipping); adaptive: a new segment from the exit.
-            float k = u_adaptive != 0 ? max(ceil((texit - t) / dt), 1.0) : ceil((texit - t) / dt - 0.5);
+            float k = u_adaptive != 0 ? max(ceil((texit - t) / dt), 1.0) : ceil((texit - t) / dt - off);
             if (skip && k >= 1.0) {
                 ks += int(k);
                 t = u_adaptive != 0 ? max(texit, t) + 1e-4 * min(min(side.x, side.y), side.z) : t0 + float(ks) * dt;
@@ -94,7 +98,7 @@ void main()
             }
         }
         float seg = min(dt, t1 - t);
-        float tm = u_adaptive != 0 || seg < dt ? t + 0.5 * seg : t0 + (float(ks) + 0.5) * dt;
+        float tm = u_adaptive != 0 || seg < dt ? t + off * seg : t0 + (float(ks) + off) * dt;
         vec3 pm = clamp(eye + tm * d, u_lr_domain_lo, u_lr_domain_hi);
         int es = lr_in_box(pm, elo, ehi) ? e : lr_find_element(pm);
         ks++;

@@ -97,7 +97,7 @@ sl_march_result sl_volume_march(vec3 eye_v, vec3 d, float t0, float t1)
     float L = t1 - t0, dt = u_dt;
     float off = 0.5;
     if (u_jitter != 0)
-        off = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+        off = sl_volume_jitter(gl_FragCoord.xy);
     // Samples k < n on the lattice t0 + (k + off) dt (exponent u_step); sample n,
     // when rem > 0, at the middle of the remainder (its own exponent).
     int n = u_jitter != 0 ? max(int(ceil(L / dt - off)), 0) : int(floor(L / dt));
