@@ -17,13 +17,23 @@
  * single, mixed and double on the GPU. Fig. 10: adaptive he, bs, rkf45 at
  * tol 1e-2 .. 1e-10 and the heuristic rk4 / rkf5 (h = H * voxel/2, H = 2^-k
  * ... as base steps) in mixed precision on the GPU. Every row also has the
- * CPU double run's ms. GPU ms: wall time of the dispatch to glFinish (each
- * variant run once before, so shader compilation is not timed), the median
- * of 3. `cut`: lines stopped by max_samples (4096) before t_max or the
+ * CPU double run's ms. GPU ms: the wall time of the whole trace call, seed
+ * upload, dispatch, glFinish and the read-back of the samples ("to
+ * read-back"), and of the dispatch to glFinish alone (each variant run once
+ * before, so shader compilation is not timed), medians of 3. `cut`: lines
+ * stopped by max_samples (4096) before t_max or the
  * boundary — their E covers only the part traced, so such rows are not
- * comparable (the SVG leaves them out). Writes the Markdown tables to stdout and one SVG plot (log E against
- * log ms) per figure and field into --out DIR (default bench-out).
- * Usage: bench-streamlines [--out DIR] [--only helix|abc] [--quick]
+ * comparable (the SVG leaves them out).
+ * `lr`: an LR-spline vector field, tests/data/lr/refined_quadratic.lr.gz (a
+ * file of the reference library: the identity map v(x) = x on [0, 1]^3 as a
+ * locally refined quadratic, 1240 elements), whose streamlines x0 e^t are
+ * exact; 64 Halton seeds in [0.1, 0.5]^3, t_max 3 (every line leaves through
+ * a face first); Fig. 9 rows at h = 0.1 / 2^k, and Fig. 10 rows (adaptive
+ * he, bs, rkf45; heuristic rk4 and rkf5 with h = H x the element's min side
+ * / 4) in single, mixed and double, each with E against the exact solution.
+ * Writes the Markdown tables to stdout and one SVG plot (log E against
+ * log ms to read-back) per figure and field into --out DIR (default bench-out).
+ * Usage: bench-streamlines [--out DIR] [--only helix|abc|lr] [--quick]
  * Main thread owns the GL context.
  */
 #include <math.h>
@@ -33,6 +43,7 @@
 #include <sys/stat.h>
 
 #include "core/sl_clock.h"
+#include "data/sl_dataset_open.h"
 #include "flow/flow_gpu.h"
 #include "flow/sl_flow.h"
 #include "gpu/sl_gpu.h"
@@ -44,7 +55,9 @@ typedef struct bench_field {
     double t_max;
     double *seeds;
     size_t seed_count;
-    int exact;                   /* helix: closed form known */
+    sl_flow_exact_fn exact;      /* the closed form (helix, lr), else NULL */
+    double base_step;            /* Fig. 9: h = base_step / 2^k */
+    int fig10_precisions;        /* Fig. 10 rows in all precisions (1) or mixed only (0) */
 } bench_field;
 
 static sl_dataset *sample_volume(const char *name, const int dims[3], const double org[3], double sp,
@@ -81,16 +94,26 @@ static sl_dataset *sample_volume(const char *name, const int dims[3], const doub
     return ds;
 }
 
-typedef struct exact_ctx {
-    const bench_field *bf;
-} exact_ctx;
-
 static void helix_exact(void *user, size_t line, double t, double x[3])
 {
-    const bench_field *bf = ((exact_ctx *)user)->bf;
+    const bench_field *bf = user;
     sl_flow_field h;
     sl_flow_field_helix(&h, 1.0, 0.5, bf->f.lo, bf->f.hi);
     sl_flow_helix_exact(&h, bf->seeds + 3 * line, t, x);
+}
+
+/* v(x) = x: x(t) = x0 e^t. */
+static void identity_exact(void *user, size_t line, double t, double x[3])
+{
+    const bench_field *bf = user;
+    for (int c = 0; c < 3; c++)
+        x[c] = bf->seeds[3 * line + (size_t)c] * exp(t);
+}
+
+static const char *source_dir(void)
+{
+    const char *src = getenv("SIGHTLINE_SOURCE_DIR");
+    return src ? src : SIGHTLINE_SOURCE_DIR;
 }
 
 typedef struct row {
@@ -99,7 +122,7 @@ typedef struct row {
     const char *precision;
     double param;                /* step, H or tol */
     const char *param_name;
-    double E, E_true, gpu_ms, cpu_ms;
+    double E, E_true, gpu_ms, wall_ms, cpu_ms;   /* gpu_ms: dispatch to glFinish; wall_ms: the trace call */
     size_t samples;
     size_t truncated;            /* lines stopped by max_samples before t_max / the boundary */
 } row;
@@ -123,19 +146,23 @@ static int run_one(sl_flow_gpu *g, bench_field *bf, const sl_flow_result *ref, c
         return -1;
     }
     sl_flow_result_free(&res);
+    double wall[3];
     for (int k = 0; k < 3; k++) {
+        double t0 = sl_clock_ms();
         if (sl_flow_gpu_trace(g, bf->seeds, bf->seed_count, o, p, &res, &ms[k], &err) != SL_OK) {
             fprintf(stderr, "bench-streamlines: %s\n", err.message);
             return -1;
         }
+        wall[k] = sl_clock_ms() - t0;
         if (k < 2)
             sl_flow_result_free(&res);
     }
     qsort(ms, 3, sizeof ms[0], cmp_double);
+    qsort(wall, 3, sizeof wall[0], cmp_double);
     r->gpu_ms = ms[1];
+    r->wall_ms = wall[1];
     r->E = sl_flow_error(&res, ref, NULL, NULL);
-    exact_ctx ec = {bf};
-    r->E_true = bf->exact ? sl_flow_error(&res, NULL, helix_exact, &ec) : NAN;
+    r->E_true = bf->exact ? sl_flow_error(&res, NULL, bf->exact, bf) : NAN;
     r->samples = 0;
     r->truncated = 0;
     for (size_t j = 0; j < res.line_count; j++) {
@@ -164,9 +191,9 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
     }
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
     for (int i = 0; i < n; i++) {
-        if (rows[i].fig != fig || !(rows[i].E > 0) || !(rows[i].gpu_ms > 0) || rows[i].truncated)
+        if (rows[i].fig != fig || !(rows[i].E > 0) || !(rows[i].wall_ms > 0) || rows[i].truncated)
             continue;
-        double x = log10(rows[i].gpu_ms), y = log10(rows[i].E);
+        double x = log10(rows[i].wall_ms), y = log10(rows[i].E);
         x0 = fmin(x0, x), x1 = fmax(x1, x), y0 = fmin(y0, y), y1 = fmax(y1, y);
     }
     if (!(x1 > x0)) x1 = x0 + 1;
@@ -184,7 +211,7 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
     for (double v = y0; v <= y1 + 1e-9; v += 1)
         fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='#ddd'/><text x='%g' y='%g' text-anchor='end'>1e%g</text>\n",
                 L, PY(v), W - R, PY(v), L - 4, PY(v) + 4, v);
-    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>GPU ms (dispatch to glFinish)</text>\n", (L + W - R) / 2, H - 12);
+    fprintf(f, "<text x='%g' y='%g' text-anchor='middle'>GPU ms (trace to read-back)</text>\n", (L + W - R) / 2, H - 12);
     fprintf(f, "<text x='16' y='%g' transform='rotate(-90 16 %g)' text-anchor='middle'>E (Eq. 7)</text>\n", (T + H - B) / 2, (T + H - B) / 2);
     static const char *colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
     int series = 0;
@@ -204,9 +231,9 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
                 dashed ? " stroke-dasharray='5,3'" : "");
         for (int k = i; k < n; k++)
             if (rows[k].fig == fig && strcmp(rows[k].label, rows[i].label) == 0 &&
-                strcmp(rows[k].precision, rows[i].precision) == 0 && rows[k].E > 0 && rows[k].gpu_ms > 0 &&
+                strcmp(rows[k].precision, rows[i].precision) == 0 && rows[k].E > 0 && rows[k].wall_ms > 0 &&
                 !rows[k].truncated)
-                fprintf(f, "%.1f,%.1f ", PX(log10(rows[k].gpu_ms)), PY(log10(rows[k].E)));
+                fprintf(f, "%.1f,%.1f ", PX(log10(rows[k].wall_ms)), PY(log10(rows[k].E)));
         fprintf(f, "'/>\n");
         fprintf(f, "<line x1='%g' y1='%g' x2='%g' y2='%g' stroke='%s' stroke-width='2'%s/><text x='%g' y='%g'>%s %s</text>\n",
                 W - R + 10, T + 10 + 16 * series, W - R + 34, T + 10 + 16 * series, c,
@@ -223,9 +250,9 @@ static void write_svg(const char *path, const char *title, const row *rows, int 
 static void print_table(const bench_field *bf, const row *rows, int n, int fig)
 {
     printf("\n### %s — Fig. %d analogue (%zu lines, t_max %g)\n\n", bf->name, fig, bf->seed_count, bf->t_max);
-    printf("| solver | precision | %s | samples | cut | E (Eq. 7, vs RKF5 h=1e-4) |%s GPU ms | CPU ms (double) |\n",
-           fig == 9 ? "step h" : "tol / H", bf->exact ? " E vs exact |" : "");
-    printf("|---|---|---|---|---|---|%s---|---|\n", bf->exact ? "---|" : "");
+    printf("| solver | precision | %s | samples | cut | E (Eq. 7, vs RKF5 h=1e-4) |%s GPU ms to read-back | "
+           "GPU ms dispatch | CPU ms (double) |\n", fig == 9 ? "step h" : "tol / H", bf->exact ? " E vs exact |" : "");
+    printf("|---|---|---|---|---|---|%s---|---|---|\n", bf->exact ? "---|" : "");
     for (int i = 0; i < n; i++) {
         if (rows[i].fig != fig)
             continue;
@@ -233,7 +260,7 @@ static void print_table(const bench_field *bf, const row *rows, int n, int fig)
                rows[i].param, rows[i].samples, rows[i].truncated, rows[i].E);
         if (bf->exact)
             printf(" %.3g |", rows[i].E_true);
-        printf(" %.2f | %.2f |\n", rows[i].gpu_ms, rows[i].cpu_ms);
+        printf(" %.2f | %.2f | %.2f |\n", rows[i].wall_ms, rows[i].gpu_ms, rows[i].cpu_ms);
     }
 }
 
@@ -249,7 +276,7 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--quick") == 0)
             quick = 1;
         else {
-            fprintf(stderr, "usage: bench-streamlines [--out DIR] [--only helix|abc] [--quick]\n");
+            fprintf(stderr, "usage: bench-streamlines [--out DIR] [--only helix|abc|lr] [--quick]\n");
             return 2;
         }
     }
@@ -262,18 +289,33 @@ int main(int argc, char **argv)
     }
     printf("## Streamlines: run time against error (issue 15, Fig. 9 and 10)\n\nGPU: %s.\n",
            sl_gpu_renderer(gpu));
-    bench_field fields[2] = {{.name = "helix", .t_max = 3.0, .exact = 1}, {.name = "abc", .t_max = 2.0}};
+    enum { FIELDS = 3 };
+    bench_field fields[FIELDS] = {{.name = "helix", .t_max = 3.0, .exact = helix_exact, .base_step = 0.2},
+                                  {.name = "abc", .t_max = 2.0, .base_step = 0.2},
+                                  {.name = "lr", .t_max = 3.0, .exact = identity_exact, .base_step = 0.1,
+                                   .fig10_precisions = 1}};
     const int hd[3] = {33, 33, 17}, ad[3] = {33, 33, 33};
     const double ho[3] = {-2, -2, -1}, ao[3] = {0, 0, 0};
     fields[0].ds = sample_volume("helix", hd, ho, 0.125, 0);
     fields[1].ds = sample_volume("abc", ad, ao, 2 * M_PI / 32, 1);
     sl_flow_seeds_box("-1,-1,-0.5,1,1,0.5,64", &fields[0].seeds, &fields[0].seed_count, &err);
     sl_flow_seeds_box("0.5,0.5,0.5,5.8,5.8,5.8,64", &fields[1].seeds, &fields[1].seed_count, &err);
+    sl_flow_seeds_box("0.1,0.1,0.1,0.5,0.5,0.5,64", &fields[2].seeds, &fields[2].seed_count, &err);
     int steps = quick ? 4 : 8, tols = quick ? 4 : 9;
-    for (int fi = 0; fi < 2; fi++) {
+    for (int fi = 0; fi < FIELDS; fi++) {
         bench_field *bf = &fields[fi];
         if (only && strcmp(only, bf->name) != 0)
             continue;
+        if (fi == 2) { /* the LR file, loaded only when its table runs */
+            char path[1024];
+            snprintf(path, sizeof path, "%s/tests/data/lr/refined_quadratic.lr.gz", source_dir());
+            if (sl_dataset_open(path, NULL, &bf->ds, &err) != SL_OK) {
+                fprintf(stderr, "bench-streamlines: %s\n", err.message);
+                return 1;
+            }
+            printf("\nlr: %s, %zu elements, domain [%g, %g]^3\n", path, bf->ds->lr->element_count,
+                   bf->ds->lr->domain_lo[0], bf->ds->lr->domain_hi[0]);
+        }
         if (!bf->ds || !bf->seeds || sl_flow_field_from_dataset(&bf->f, bf->ds, &err) != SL_OK) {
             fprintf(stderr, "bench-streamlines: field %s could not be made\n", bf->name);
             return 1;
@@ -290,18 +332,16 @@ int main(int argc, char **argv)
             fprintf(stderr, "bench-streamlines: reference: %s\n", err.message);
             return 1;
         }
-        if (bf->exact) {
-            exact_ctx ec = {bf};
-            printf("\n%s reference (RKF5 h = 1e-4, CPU double) against the exact helix: E = %.3g\n", bf->name,
-                   sl_flow_error(&ref, NULL, helix_exact, &ec));
-        }
+        if (bf->exact)
+            printf("\n%s reference (RKF5 h = 1e-4, CPU double) against the exact solution: E = %.3g\n", bf->name,
+                   sl_flow_error(&ref, NULL, bf->exact, bf));
         static row rows[MAX_ROWS];
         int n = 0;
         static const sl_flow_solver fig9[3] = {SL_FLOW_RK2, SL_FLOW_RK4, SL_FLOW_RKF5};
         for (int s = 0; s < 3; s++)
             for (int p = SL_FLOW_SINGLE; p <= SL_FLOW_DOUBLE; p++)
                 for (int k = 0; k < steps && n < MAX_ROWS; k++) {
-                    double h = 0.2 / (double)(1 << k);
+                    double h = bf->base_step / (double)(1 << k);
                     sl_flow_options o = {.solver = fig9[s], .mode = SL_FLOW_STEP_FIXED, .step = h,
                                          .t_max = bf->t_max, .max_samples = 4096};
                     row *r = &rows[n];
@@ -313,36 +353,41 @@ int main(int argc, char **argv)
                     if (run_one(g, bf, &ref, &o, (sl_flow_precision)p, r) == 0)
                         n++;
                 }
+        /* Fig. 10: mixed only, or every precision (lr). */
+        int p_lo = bf->fig10_precisions ? SL_FLOW_SINGLE : SL_FLOW_MIXED;
+        int p_hi = bf->fig10_precisions ? SL_FLOW_DOUBLE : SL_FLOW_MIXED;
         static const sl_flow_solver adaptive[3] = {SL_FLOW_HE, SL_FLOW_BS, SL_FLOW_RKF45};
         for (int s = 0; s < 3; s++)
-            for (int k = 0; k < tols && n < MAX_ROWS; k++) {
-                double tol = pow(10.0, -2 - k);
-                sl_flow_options o = {.solver = adaptive[s], .mode = SL_FLOW_STEP_ADAPTIVE, .tol = tol,
-                                     .t_max = bf->t_max, .max_samples = 4096};
-                row *r = &rows[n];
-                snprintf(r->label, sizeof r->label, "%s", sl_flow_methods[adaptive[s]].name);
-                r->fig = 10;
-                r->precision = "mixed";
-                r->param = tol;
-                r->param_name = "tol";
-                if (run_one(g, bf, &ref, &o, SL_FLOW_MIXED, r) == 0)
-                    n++;
-            }
+            for (int p = p_lo; p <= p_hi; p++)
+                for (int k = 0; k < tols && n < MAX_ROWS; k++) {
+                    double tol = pow(10.0, -2 - k);
+                    sl_flow_options o = {.solver = adaptive[s], .mode = SL_FLOW_STEP_ADAPTIVE, .tol = tol,
+                                         .t_max = bf->t_max, .max_samples = 4096};
+                    row *r = &rows[n];
+                    snprintf(r->label, sizeof r->label, "%s", sl_flow_methods[adaptive[s]].name);
+                    r->fig = 10;
+                    r->precision = sl_flow_precision_name((sl_flow_precision)p);
+                    r->param = tol;
+                    r->param_name = "tol";
+                    if (run_one(g, bf, &ref, &o, (sl_flow_precision)p, r) == 0)
+                        n++;
+                }
         static const sl_flow_solver heur[2] = {SL_FLOW_RK4, SL_FLOW_RKF5};
         for (int s = 0; s < 2; s++)
-            for (int k = 0; k < steps && n < MAX_ROWS; k++) {
-                double H = 2.0 / (double)(1 << k);
-                sl_flow_options o = {.solver = heur[s], .mode = SL_FLOW_STEP_HEURISTIC, .step = H,
-                                     .t_max = bf->t_max, .max_samples = 4096};
-                row *r = &rows[n];
-                snprintf(r->label, sizeof r->label, "%s heuristic", sl_flow_methods[heur[s]].name);
-                r->fig = 10;
-                r->precision = "mixed";
-                r->param = H;
-                r->param_name = "H";
-                if (run_one(g, bf, &ref, &o, SL_FLOW_MIXED, r) == 0)
-                    n++;
-            }
+            for (int p = p_lo; p <= p_hi; p++)
+                for (int k = 0; k < steps && n < MAX_ROWS; k++) {
+                    double H = 2.0 / (double)(1 << k);
+                    sl_flow_options o = {.solver = heur[s], .mode = SL_FLOW_STEP_HEURISTIC, .step = H,
+                                         .t_max = bf->t_max, .max_samples = 4096};
+                    row *r = &rows[n];
+                    snprintf(r->label, sizeof r->label, "%s heuristic", sl_flow_methods[heur[s]].name);
+                    r->fig = 10;
+                    r->precision = sl_flow_precision_name((sl_flow_precision)p);
+                    r->param = H;
+                    r->param_name = "H";
+                    if (run_one(g, bf, &ref, &o, (sl_flow_precision)p, r) == 0)
+                        n++;
+                }
         print_table(bf, rows, n, 9);
         print_table(bf, rows, n, 10);
         char path[512], title[128];
@@ -355,7 +400,7 @@ int main(int argc, char **argv)
         sl_flow_result_free(&ref);
         sl_flow_gpu_destroy(g);
     }
-    for (int fi = 0; fi < 2; fi++) {
+    for (int fi = 0; fi < FIELDS; fi++) {
         free(fields[fi].seeds);
         sl_dataset_destroy(fields[fi].ds);
     }
