@@ -1,7 +1,9 @@
-/* test_server_cluster.c — three render nodes behind HAProxy on one shared catalog
- * (a SQLite file; PostgreSQL is the next step), all started by this test through
- * scripts/cluster, loopback only.
+/* test_server_cluster.c — three render nodes behind HAProxy on one shared
+ * PostgreSQL catalog, all started by this test through scripts/cluster (which
+ * starts a throwaway PostgreSQL with scripts/pg-temp), loopback only.
  *
+ *  0. the catalog is PostgreSQL, and the dataset registered there through one
+ *     CLI call is what every node serves;
  *  1. 30 new sessions through the balancer spread over all three nodes (each
  *     gets at least 5), and every session id starts with the node that says
  *     `welcome.node`;
@@ -41,7 +43,7 @@ static int failures;
 
 typedef struct cluster {
     char dir[64];           /* /tmp/sl-cluster-test-XXXXXX */
-    char db[256];           /* the shared catalog file */
+    char db[256];           /* the shared catalog: the URL scripts/cluster printed */
     pid_t script;           /* scripts/cluster */
     FILE *out;              /* its stdout */
     int port;               /* HAProxy */
@@ -108,6 +110,20 @@ static int process_alive(pid_t pid)
     return paren && paren[1] == ' ' && paren[2] != 'Z' && paren[2] != 'X';
 }
 
+/* The sessions' dataset, registered once in the shared catalog by the CLI
+ * (the nodes look the default dataset up at each hello). */
+static int register_tiny(cluster *c)
+{
+    char cmd[1024], sink[256];
+    snprintf(cmd, sizeof cmd, "'%s/bin/sightline-server' --db '%s' catalog add-generator tiny '%s' 2>&1", bin_dir(),
+             c->db, HARNESS_TINY);
+    if (run_capture(cmd, sink, sizeof sink) != 0) {
+        fprintf(stderr, "cluster: could not register the dataset: %s\n", sink);
+        return -1;
+    }
+    return 0;
+}
+
 static int cluster_start(cluster *c)
 {
     memset(c, 0, sizeof *c);
@@ -115,15 +131,6 @@ static int cluster_start(cluster *c)
     snprintf(c->dir, sizeof c->dir, "/tmp/sl-cluster-test-XXXXXX");
     if (!mkdtemp(c->dir))
         return -1;
-    char cmd[1024];
-    snprintf(c->db, sizeof c->db, "%s/catalog.db", c->dir);
-    char sink[256];
-    snprintf(cmd, sizeof cmd, "'%s/bin/sightline-server' --db '%s' catalog add-generator tiny '%s' 2>&1", bin_dir(),
-             c->db, HARNESS_TINY);
-    if (run_capture(cmd, sink, sizeof sink) != 0) {
-        fprintf(stderr, "cluster: could not register the dataset: %s\n", sink);
-        return -1;
-    }
     c->port = free_port();
     int base = free_port();
     if (c->port <= 0 || base <= 0 || base > 60000)
@@ -143,8 +150,7 @@ static int cluster_start(cluster *c)
         snprintf(build, sizeof build, "%s", bin_dir());
         snprintf(portv, sizeof portv, "%d", c->port);
         snprintf(basev, sizeof basev, "%d", base);
-        char *argv[] = {"bash", script, "--nodes", "3", "--port", portv, "--base-port", basev, "--db", c->db,
-                        "--build", build, "--data-dir", c->dir, "--", "--default-dataset", "tiny",
+        char *argv[] = {"bash", script, "--nodes", "3", "--port", portv, "--base-port", basev, "--build", build, "--data-dir", c->dir, "--", "--default-dataset", "tiny",
                         "--max-pending", "64", "--max-clients", "128", "--max-sessions", "64", "--grace", "20",
                         NULL};
         execvp("bash", argv);
@@ -173,8 +179,10 @@ static int cluster_start(cluster *c)
             c->node_port[i - 1] = port;
             nodes_seen++;
         }
+        if (sscanf(line, "cluster: catalog %255s", c->db) == 1)
+            continue;
         if (strncmp(line, "cluster: open", 13) == 0)
-            return nodes_seen == NODES ? 0 : -1;
+            return nodes_seen == NODES && c->db[0] ? register_tiny(c) : -1;
     }
     fprintf(stderr, "cluster: scripts/cluster did not come up\n");
     return -1;
@@ -277,6 +285,8 @@ int main(void)
         fprintf(stderr, "FAIL: the cluster did not start\n");
         return 1;
     }
+    /* 0. The nodes share one PostgreSQL catalog. */
+    CHECK(strncmp(cl.db, "postgresql://", 13) == 0, "the cluster's catalog is %s, not PostgreSQL", cl.db);
 
     /* 1. New sessions spread over the nodes. */
     static tclient s[NEW_SESSIONS];
