@@ -4,7 +4,7 @@
  *
  * Why a folder of its own: the same integrators serve regular vector
  * volumes (trilinear), LR-spline vector volumes and analytic test fields,
- * and feed sightline-trace, the benchmarks and (later) the tubes of
+ * and feed sightline-trace, the benchmarks and the streamline tubes of
  * lr_volume; none of those owns them.
  *
  * Pieces: sl_flow_field (sampling, CPU, double), the Runge-Kutta table
