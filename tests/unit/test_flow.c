@@ -381,8 +381,18 @@ static void test_seeds_and_metric(void)
     SL_CHECK_NEAR(sl_flow_line_error(&y, &ref, NULL, NULL, 0), 1e-3, 1e-12);
 }
 
+/* The schema names are the table's, in order, and find takes each back. */
+static void test_names(void)
+{
+    for (int i = 0; i < SL_FLOW_SOLVER_COUNT; i++)
+        SL_CHECK(sl_flow_solver_names[i] && strcmp(sl_flow_solver_names[i], sl_flow_methods[i].name) == 0 &&
+                 sl_flow_solver_find(sl_flow_solver_names[i]) == i);
+    SL_CHECK(sl_flow_solver_names[SL_FLOW_SOLVER_COUNT] == NULL);
+}
+
 int main(void)
 {
+    test_names();
     test_orders();
     test_adaptive();
     test_boundary_and_degenerate();
