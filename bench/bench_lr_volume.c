@@ -1,7 +1,7 @@
 /* bench_lr_volume.c — run time against image error of `lr_volume`: adaptive
  * step (min element side / 2^d, paper Eq. 4) against the uniform step.
  *
- *   bench-lr-volume [--small | --size WxH] [--frames N] [--error-size WxH] [--table steps|woodgrain|peer]
+ *   bench-lr-volume [--small | --size WxH] [--frames N] [--error-size WxH] [--table steps|woodgrain|peer|streamlines]
  *
  * Dataset: lr_field sphere, degree 2, 6 cells, grading 0.6 (element sides
  * varying 4x; 216 elements; k-d forest look-up). Fixed transfer function (points form),
@@ -16,7 +16,12 @@
  * through lr_volume, and the marschner_lobb voxels through volume_dvr (what a
  * user would otherwise pick), same camera, transfer function and step of
  * half a voxel (no jitter, no shading); ms per frame, their ratio and the
- * images' difference. Wood-grain (third table): uniform 2 and 1, adaptive
+ * images' difference. Streamline tubes (third table): the cost of the tubes
+ * in the frame (lr_field sphere as a vector field, the same grading): ms per
+ * frame without them and with 64 / 256 seeds (rk4, mixed precision, the
+ * default heuristic step), the trace's one-time cost (trace + tubes prepare,
+ * the first frame's rebuild_ms) apart, and the orbit's frames after it (the
+ * cache holds: no frame traces again). Wood-grain (fourth table): uniform 2 and 1, adaptive
  * d = 0 and 1, each with samples at segment midpoints and with the
  * per-pixel jitter (parameter `jitter`), the error of the whole frame at the
  * bench size against uniform 1/32 without jitter at that size: mean, max and
@@ -246,6 +251,58 @@ static sl_status woodgrain_table(sl_pipeline *p, const sl_technique *t, const sl
     return st;
 }
 
+/* Frames with streamline tubes against the volume alone (same view and TF). */
+static sl_status streamline_table(sl_gpu *gpu, const sl_bench_options *bo, sl_err *err)
+{
+    static const char *const FIELD =
+        "{\"generator\":\"lr_field\",\"field\":\"sphere\",\"degree\":2,\"cells\":6,\"grading\":0.6,"
+        "\"components\":\"vector\"}";
+    static const char *const rows[] = {
+        "{}",
+        "{\"streamlines\":true,\"seed_count\":64}",
+        "{\"streamlines\":true,\"seed_count\":256}",
+    };
+    const sl_technique *t = sl_technique_find("lr_volume");
+    sl_pipeline *p = NULL;
+    sl_dataset *ds = NULL;
+    sl_status st = sl_pipeline_create(gpu, &p, err);
+    if (st == SL_OK && (st = sl_generate_json(FIELD, &ds, err)) == SL_OK)
+        sl_pipeline_set_dataset(p, ds);
+    if (st == SL_OK)
+        printf("\n## lr_volume: streamline tubes in the frame\n\n%s; timing at %dx%d, median of %d "
+               "orbit frames after the first (which traces: its rebuild ms is the trace + tubes prepare)\n\n"
+               "| streamlines | seeds | trace + tubes prepare ms (once) | ms / frame | ratio to the volume alone |\n"
+               "|---|---|---|---|---|\n", FIELD, bo->width, bo->height, bo->frames);
+    double alone = 0;
+    for (size_t r = 0; r < sizeof rows / sizeof rows[0] && st == SL_OK; r++) {
+        sl_params q;
+        sl_params_init(&q, t->params, t->param_count);
+        cJSON *base = cJSON_Parse(BASE_PARAMS), *extra = cJSON_Parse(rows[r]);
+        st = base && extra && sl_params_apply_json(&q, base, err) == SL_OK ? sl_params_apply_json(&q, extra, err)
+                                                                         : sl_err_set(err, SL_ERR_INVALID, "bad row");
+        cJSON_Delete(base);
+        cJSON_Delete(extra);
+        sl_view v;
+        sl_frame_stats fs;
+        if (st == SL_OK && (st = view_at(sl_pipeline_dataset(p), bo->width, bo->height, &v, err)) == SL_OK &&
+            (st = sl_pipeline_set_technique(p, t, &q, err)) == SL_OK)
+            st = sl_pipeline_render(p, &v, 1, &fs, err);
+        sl_bench_timing tm;
+        if (st == SL_OK)
+            st = sl_bench_time_frames(p, t, &q, bo, SL_QUALITY_STILL, sl_bench_orbit_camera, &orbit, &tm, err);
+        if (st != SL_OK)
+            break;
+        if (r == 0)
+            alone = tm.median_ms;
+        int seeds = r == 0 ? 0 : r == 1 ? 64 : 256;
+        printf("| %s | %d | %.0f | %.1f | %.2f |\n", r == 0 ? "off" : r == 1 ? "64 seeds" : "256 seeds", seeds,
+               fs.render.rebuild_ms, tm.median_ms, alone > 0 ? tm.median_ms / alone : 0.0);
+        fflush(stdout);
+    }
+    sl_pipeline_destroy(p);
+    return st;
+}
+
 int main(int argc, char **argv)
 {
     sl_bench_options bo;
@@ -265,11 +322,11 @@ int main(int argc, char **argv)
         }
         if (strcmp(argv[i], "--table") == 0 && i + 1 < argc &&
             (strcmp(argv[i + 1], "steps") == 0 || strcmp(argv[i + 1], "woodgrain") == 0 ||
-             strcmp(argv[i + 1], "peer") == 0)) {
+             strcmp(argv[i + 1], "peer") == 0 || strcmp(argv[i + 1], "streamlines") == 0)) {
             only = argv[++i];
             continue;
         }
-        fprintf(stderr, "usage: bench-lr-volume %s [--error-size WxH] [--table steps|woodgrain|peer]\n",
+        fprintf(stderr, "usage: bench-lr-volume %s [--error-size WxH] [--table steps|woodgrain|peer|streamlines]\n",
                 SL_BENCH_OPTIONS_HELP);
         return 1;
     }
@@ -296,6 +353,8 @@ int main(int argc, char **argv)
         st = woodgrain_table(p, t, &base, ds, &bo, &err);
     if (st == SL_OK && (!only || strcmp(only, "peer") == 0))
         st = peer_table(gpu, &bo, ew, eh, &err);
+    if (st == SL_OK && (!only || strcmp(only, "streamlines") == 0))
+        st = streamline_table(gpu, &bo, &err);
     if (st != SL_OK)
         fprintf(stderr, "bench-lr-volume: %s\n", err.message);
     sl_pipeline_destroy(p);

@@ -23,41 +23,8 @@
 #include <pthread.h>
 #include <stdatomic.h>
 
+#include "harness/sl_bench.h"
 #include "sl_server_harness.h"
-
-typedef struct stat_acc {
-    double v[4096];
-    int n;
-} stat_acc;
-
-static void acc_add(stat_acc *a, double x)
-{
-    if (a->n < 4096)
-        a->v[a->n++] = x;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double acc_pct(stat_acc *a, double p)
-{
-    if (a->n == 0)
-        return NAN;
-    qsort(a->v, (size_t)a->n, sizeof a->v[0], cmp_double);
-    int i = (int)ceil(p / 100.0 * a->n) - 1;
-    return a->v[i < 0 ? 0 : i];
-}
-
-static double acc_mean(const stat_acc *a)
-{
-    double s = 0;
-    for (int i = 0; i < a->n; i++)
-        s += a->v[i];
-    return a->n ? s / a->n : NAN;
-}
 
 typedef struct viewer {
     int port;
@@ -118,8 +85,8 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
     ctl.auto_ack = 1;
     tclient_wait_frame(&ctl, 0, 1, 120000); /* dataset load + prepare */
 
-    stat_acc lat_move = {0}, lat_still = {0}, enc_i = {0}, enc_s = {0}, bytes_i = {0}, bytes_s = {0};
-    stat_acc render_i = {0}, render_s = {0};
+    sl_bench_stat lat_move = {0}, lat_still = {0}, enc_i = {0}, enc_s = {0}, bytes_i = {0}, bytes_s = {0};
+    sl_bench_stat render_i = {0}, render_s = {0};
     int iw = 0, ih = 0;
     uint32_t seq = 0;
     /* Interactive latency: one move at a time, next after its frame is shown. */
@@ -128,7 +95,7 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
         send_camera(&ctl, ++seq, "move", i * 3.0);
         if (tclient_wait_frame(&ctl, seq, 0, 30000) != 0)
             break;
-        acc_add(&lat_move, ctl.last.arrival_ms - t0);
+        sl_bench_stat_add(&lat_move, ctl.last.arrival_ms - t0);
     }
     send_camera(&ctl, ++seq, "end", 120.0);
     tclient_wait_frame(&ctl, seq, 1, 30000);
@@ -138,7 +105,7 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
         send_camera(&ctl, ++seq, NULL, 130.0 + i * 5.0);
         if (tclient_wait_frame(&ctl, seq, 1, 30000) != 0)
             break;
-        acc_add(&lat_still, ctl.last.arrival_ms - t0);
+        sl_bench_stat_add(&lat_still, ctl.last.arrival_ms - t0);
     }
 
     /* FPS to 1, 4, 16 clients of one session (the controller counts as one). */
@@ -162,9 +129,9 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
                 break;
             double mpx = ctl.last.h.width * ctl.last.h.height / 1e6;
             if (ctl.last.h.flags & SL_FRAME_FLAG_INTERACTIVE) {
-                acc_add(&enc_i, ctl.last.h.encode_ms / mpx);
-                acc_add(&bytes_i, ctl.last.h.payload_bytes);
-                acc_add(&render_i, ctl.last.h.render_ms);
+                sl_bench_stat_add(&enc_i, ctl.last.h.encode_ms / mpx);
+                sl_bench_stat_add(&bytes_i, ctl.last.h.payload_bytes);
+                sl_bench_stat_add(&render_i, ctl.last.h.render_ms);
                 iw = ctl.last.h.width;
                 ih = ctl.last.h.height;
             }
@@ -190,9 +157,9 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
         if (tclient_wait_frame(&ctl, seq, 1, 30000) != 0)
             break;
         double mpx = ctl.last.h.width * ctl.last.h.height / 1e6;
-        acc_add(&enc_s, ctl.last.h.encode_ms / mpx);
-        acc_add(&bytes_s, ctl.last.h.payload_bytes);
-        acc_add(&render_s, ctl.last.h.render_ms);
+        sl_bench_stat_add(&enc_s, ctl.last.h.encode_ms / mpx);
+        sl_bench_stat_add(&bytes_s, ctl.last.h.payload_bytes);
+        sl_bench_stat_add(&render_s, ctl.last.h.render_ms);
     }
     tclient_close(&ctl);
     harness_stop(&hs);
@@ -201,17 +168,17 @@ static int overhead_table(const char *dataset, int w, int h, double seconds)
            dataset, w, h, iw, ih);
     printf("| metric | value |\n| --- | --- |\n");
     printf("| latency camera->frame, interactive (median / p95) | %.1f / %.1f ms (n=%d) |\n",
-           acc_pct(&lat_move, 50), acc_pct(&lat_move, 95), lat_move.n);
+           sl_bench_stat_pct(&lat_move, 50), sl_bench_stat_pct(&lat_move, 95), lat_move.n);
     printf("| latency camera->frame, still (median / p95) | %.1f / %.1f ms (n=%d) |\n",
-           acc_pct(&lat_still, 50), acc_pct(&lat_still, 95), lat_still.n);
+           sl_bench_stat_pct(&lat_still, 50), sl_bench_stat_pct(&lat_still, 95), lat_still.n);
     for (int k = 0; k < 3; k++)
         printf("| fps per client, %2d client(s) in one session (mean / min) | %.1f / %.1f |\n", counts[k],
                fps_mean[k], fps_min[k]);
-    printf("| render+readback ms per frame, interactive / still (mean) | %.2f / %.2f |\n", acc_mean(&render_i),
-           acc_mean(&render_s));
-    printf("| JPEG encode ms per megapixel, interactive q60 4:2:0 (mean) | %.2f |\n", acc_mean(&enc_i));
-    printf("| JPEG encode ms per megapixel, still q92 4:4:4 (mean) | %.2f |\n", acc_mean(&enc_s));
-    printf("| bytes per frame, interactive / still (mean) | %.0f / %.0f |\n", acc_mean(&bytes_i), acc_mean(&bytes_s));
+    printf("| render+readback ms per frame, interactive / still (mean) | %.2f / %.2f |\n", sl_bench_stat_mean(&render_i),
+           sl_bench_stat_mean(&render_s));
+    printf("| JPEG encode ms per megapixel, interactive q60 4:2:0 (mean) | %.2f |\n", sl_bench_stat_mean(&enc_i));
+    printf("| JPEG encode ms per megapixel, still q92 4:4:4 (mean) | %.2f |\n", sl_bench_stat_mean(&enc_s));
+    printf("| bytes per frame, interactive / still (mean) | %.0f / %.0f |\n", sl_bench_stat_mean(&bytes_i), sl_bench_stat_mean(&bytes_s));
     return 0;
 }
 
@@ -225,7 +192,7 @@ typedef struct drag_row {
     char why[160];              /* when !ok */
     int frames;                 /* interactive frames that arrived during the drag */
     double fps;
-    stat_acc latency;           /* per frame: arrival - send time of its camera seq */
+    sl_bench_stat latency;      /* per frame: arrival - send time of its camera seq */
     int last_w, last_h;         /* the newest interactive frame: the scale settled on */
     int widths[8], nwidths;     /* distinct interactive widths seen, in order */
     double still_after_ms;      /* `end` sent -> full-size still arrived */
@@ -289,7 +256,7 @@ static void drag_once(tclient *c, uint32_t *seq, const char *dataset, const char
             continue;
         uint32_t k = c->last.h.camera_seq - first;
         if (k < DRAG_MAX_SEQ)
-            acc_add(&r->latency, c->last.arrival_ms - sent[k]);
+            sl_bench_stat_add(&r->latency, c->last.arrival_ms - sent[k]);
         r->frames++;
         r->last_w = c->last.h.width;
         r->last_h = c->last.h.height;
@@ -340,7 +307,7 @@ static void print_row(const char *dataset, const char *technique, const char *mo
     }
     printf("| %s | %s | %s | %s (%dx%d; used %s) | %.1f | %.0f / %.0f | %.0f | %.0f |\n", dataset, technique, mode,
            scale_name(r->last_w, w, b1, sizeof b1), r->last_w, r->last_h, used,
-           r->fps, acc_pct(&r->latency, 50), acc_pct(&r->latency, 95), r->still_after_ms, r->still_cost_ms);
+           r->fps, sl_bench_stat_pct(&r->latency, 50), sl_bench_stat_pct(&r->latency, 95), r->still_after_ms, r->still_cost_ms);
 }
 
 /* Table 2. The tract sample is registered with `catalog add` while the server runs (SQLite WAL). */

@@ -1,25 +1,23 @@
-/* catalog.c — the SQLite catalog: datasets, saved views, named camera paths, sessions.
+/* catalog.c — the catalog: datasets, saved views, named camera paths and
+ * session checkpoints, over sl_db.h (SQLite or PostgreSQL, one SQL text
+ * for both; the schema and its migrations are in catalog_schema.c).
  *
- * One database file in WAL mode (readers never block the writer). Every
- * statement is prepared with bound parameters; no SQL is ever built from
- * input text. File datasets must lie inside one of the allowed data
- * directories after realpath(), so "../" or a symlink cannot reach outside.
- * A dataset row records what the catalog needs to list it without loading
- * it: kind, source (generator JSON or absolute path), file size and an
- * FNV-1a 64 checksum, bounds, counts and attribute names. Does not render.
- * Removal sticks: `remove` leaves a row in `removed`, and the automatic
- * registration at start (built-ins, <data-dir>/samples) skips those names;
- * only an explicit add, add-generator, scan or add-builtins brings one back.
- * Saved views are capped at SL_CATALOG_MAX_VIEWS rows, named paths (scene.md
- * "Paths", stored as the JSON text the server checked) at
- * SL_CATALOG_MAX_PATHS rows of at most SL_CATALOG_MAX_PATH_BYTES each.
- * Schema 3 added `paths`; an older file gets the table at open (CREATE IF
- * NOT EXISTS) and its schema_version raised. Schema 4 made `sessions` the
- * session checkpoints of every node (id, node, token_hash, state).
- * Used by the lws service thread (server) or the `catalog` CLI, never both
- * on one connection, never from the render thread.
+ * Every statement binds its arguments; no SQL is built from input text.
+ * File datasets must lie inside one of the allowed data directories after
+ * realpath(), so "../" or a symlink cannot reach outside. A dataset row
+ * records what the catalog needs to list it without loading it: kind,
+ * source (generator JSON or absolute path), file size and an FNV-1a 64
+ * checksum (so a node whose copy of the file differs refuses it:
+ * dataset_cache.c), bounds, counts and attribute names. Removal sticks:
+ * `remove` leaves a row in `removed`, and the automatic registration at
+ * start (built-ins, <data-dir>/samples) skips those names; only an explicit
+ * add, add-generator, scan or add-builtins brings one back. Saved views and
+ * named paths are capped (sl_catalog.h); a replacement is always allowed.
+ * Statements that must see one state (a cap and its insert, a row and its
+ * tombstone) run in one transaction. Time stamps are ISO 8601 UTC texts
+ * made here. Does not render. Service thread or the `catalog` CLI.
  */
-#include "sl_server.h"
+#include "sl_catalog.h"
 
 #include <dirent.h>
 #include <limits.h>
@@ -28,123 +26,63 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include "data/sl_generate.h"
 #include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
 #include "lrspline/sl_lr.h"
 #include "volume/sl_volume.h"
+#include "sl_protocol.h"
 
-static const char *schema_sql =
-    "CREATE TABLE IF NOT EXISTS datasets("
-    " id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, kind TEXT NOT NULL,"
-    " source_path TEXT, generator_json TEXT, description TEXT,"
-    " file_size INTEGER, checksum TEXT, bounds TEXT, counts TEXT, attributes TEXT,"
-    " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
-    "CREATE TABLE IF NOT EXISTS views("
-    " id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, dataset TEXT NOT NULL,"
-    " technique TEXT NOT NULL, params TEXT NOT NULL, camera TEXT NOT NULL,"
-    " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
-    "CREATE TABLE IF NOT EXISTS sessions("
-    " id TEXT PRIMARY KEY, node TEXT NOT NULL, token_hash TEXT NOT NULL, state TEXT NOT NULL,"
-    " created TEXT DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')),"
-    " updated TEXT DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
-    "CREATE TABLE IF NOT EXISTS removed("
-    " name TEXT PRIMARY KEY,"
-    " removed TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
-    "CREATE TABLE IF NOT EXISTS paths("
-    " id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, technique TEXT NOT NULL, path TEXT NOT NULL,"
-    " keys INTEGER NOT NULL, duration REAL NOT NULL,"
-    " created TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ','now')));"
-    "CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-    "INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '4');"
-    "UPDATE meta SET value = '4' WHERE key = 'schema_version' AND CAST(value AS INTEGER) < 4;";
+#define TEXT(s) sl_db_text_arg(s)
 
-static sl_status db_fail(sqlite3 *db, sl_err *err, const char *what)
+/* Now as "YYYY-MM-DDTHH:MM:SSZ". */
+static void utc_now(char out[32])
 {
-    return sl_err_set(err, SL_ERR_IO, "catalog: %s: %s", what, sqlite3_errmsg(db));
+    time_t t = time(NULL);
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(out, 32, "%Y-%m-%dT%H:%M:%SZ", &tm);
 }
 
-/* Before schema 4, `sessions` held (id, state) rows that lived only while
- * their server ran; such a table is dropped at open and made anew with
- * node and token_hash (schema_sql). */
-static int sessions_table_is_old(sqlite3 *db)
-{
-    sqlite3_stmt *q = NULL;
-    int has_table = 0, has_node = 0;
-    if (sqlite3_prepare_v2(db, "SELECT name FROM pragma_table_info('sessions')", -1, &q, NULL) == SQLITE_OK)
-        while (sqlite3_step(q) == SQLITE_ROW) {
-            has_table = 1;
-            has_node |= strcmp((const char *)sqlite3_column_text(q, 0), "node") == 0;
-        }
-    sqlite3_finalize(q);
-    return has_table && !has_node;
-}
-
-sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err)
+sl_status sl_catalog_open(const char *target, sl_db **out, sl_err *err)
 {
     *out = NULL;
-    sqlite3 *db = NULL;
-    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, NULL)
-        != SQLITE_OK) {
-        sl_status st = sl_err_set(err, SL_ERR_IO, "catalog: cannot open %s: %s", path,
-                                  db ? sqlite3_errmsg(db) : "out of memory");
-        sqlite3_close(db);
-        return st;
-    }
-    sqlite3_busy_timeout(db, 2000);
-    char *msg = NULL;
-    if (sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &msg) != SQLITE_OK ||
-        sqlite3_exec(db, sessions_table_is_old(db) ? "DROP TABLE sessions" : "", NULL, NULL, &msg) != SQLITE_OK ||
-        sqlite3_exec(db, schema_sql, NULL, NULL, &msg) != SQLITE_OK) {
-        sl_status st = sl_err_set(err, SL_ERR_IO, "catalog: cannot initialise %s: %s", path, msg ? msg : "?");
-        sqlite3_free(msg);
-        sqlite3_close(db);
-        return st;
+    sl_db *db = NULL;
+    sl_status st = sl_db_open(target, &db, err);
+    if (st == SL_OK && (st = sl_catalog_migrate(db, NULL, err)) != SL_OK) {
+        sl_db_close(db);
+        db = NULL;
     }
     *out = db;
-    return SL_OK;
+    return st;
 }
 
-void sl_catalog_close(sqlite3 *db)
+void sl_catalog_close(sl_db *db)
 {
-    sqlite3_close(db);
+    sl_db_close(db);
 }
 
-static int name_exists(sqlite3 *db, const char *name)
+/* 1 when a row of `sql` (one text argument) exists; a failed query counts as none. */
+static int row_exists(sl_db *db, const char *sql, const char *name)
 {
-    sqlite3_stmt *q = NULL;
-    int found = 0;
-    if (sqlite3_prepare_v2(db, "SELECT 1 FROM datasets WHERE name = ?1", -1, &q, NULL) == SQLITE_OK) {
-        sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-        found = sqlite3_step(q) == SQLITE_ROW;
-    }
-    sqlite3_finalize(q);
+    sl_db_result *r = NULL;
+    sl_err ignored = {0};
+    sl_db_arg arg = TEXT(name);
+    int found = sl_db_query(db, sql, &arg, 1, &r, &ignored) == SL_OK && sl_db_result_rows(r) > 0;
+    sl_db_result_destroy(r);
     return found;
 }
 
-/* Runs one statement with a single text parameter; for the tombstone table. */
-static sl_status exec_name(sqlite3 *db, const char *sql, const char *name, sl_err *err)
+static int name_exists(sl_db *db, const char *name)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, sql, -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "tombstone");
+    return row_exists(db, "SELECT 1 FROM datasets WHERE name = $1", name);
 }
 
-static int was_removed(sqlite3 *db, const char *name)
+static int was_removed(sl_db *db, const char *name)
 {
-    sqlite3_stmt *q = NULL;
-    int found = 0;
-    if (sqlite3_prepare_v2(db, "SELECT 1 FROM removed WHERE name = ?1", -1, &q, NULL) == SQLITE_OK) {
-        sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-        found = sqlite3_step(q) == SQLITE_ROW;
-    }
-    sqlite3_finalize(q);
-    return found;
+    return row_exists(db, "SELECT 1 FROM removed WHERE name = $1", name);
 }
 
 void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, char **attrs)
@@ -195,41 +133,45 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
     cJSON_Delete(a);
 }
 
-/* ds may be NULL (a built-in not generated yet): bounds/counts/attributes stay NULL. */
-static sl_status insert_dataset(sqlite3 *db, const char *name, const char *kind, const sl_dataset *ds,
+/* ds may be NULL (a built-in not generated yet): bounds/counts/attributes stay NULL.
+ * if_absent: an automatic registration (built-ins, samples at a node's start),
+ * which another node starting at the same moment may have made first: a row
+ * of that name is left as it is and *inserted is 0. Otherwise a duplicate
+ * name is an error. inserted may be NULL. */
+static sl_status insert_dataset(sl_db *db, const char *name, const char *kind, const sl_dataset *ds,
                                 const char *path, const char *generator, const char *description,
-                                long long file_size, const char *checksum, sl_err *err)
+                                long long file_size, const char *checksum, int if_absent, int *inserted,
+                                sl_err *err)
 {
+    long long changed = 0;
     char *bounds = NULL, *counts = NULL, *attrs = NULL;
     if (ds)
         sl_catalog_describe(ds, &bounds, &counts, &attrs);
-    sqlite3_stmt *q = NULL;
-    sl_status st = SL_OK;
-    if (sqlite3_prepare_v2(db,
-                           "INSERT INTO datasets(name, kind, source_path, generator_json, description,"
-                           " file_size, checksum, bounds, counts, attributes)"
-                           " VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
-                           -1, &q, NULL) != SQLITE_OK) {
-        st = db_fail(db, err, "prepare insert");
-    } else {
-        sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-        sqlite3_bind_text(q, 2, kind, -1, SQLITE_TRANSIENT);
-        if (path) sqlite3_bind_text(q, 3, path, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 3);
-        if (generator) sqlite3_bind_text(q, 4, generator, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 4);
-        sqlite3_bind_text(q, 5, description ? description : "", -1, SQLITE_TRANSIENT);
-        if (file_size >= 0) sqlite3_bind_int64(q, 6, file_size); else sqlite3_bind_null(q, 6);
-        if (checksum) sqlite3_bind_text(q, 7, checksum, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 7);
-        if (bounds) sqlite3_bind_text(q, 8, bounds, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 8);
-        if (counts) sqlite3_bind_text(q, 9, counts, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 9);
-        if (attrs) sqlite3_bind_text(q, 10, attrs, -1, SQLITE_TRANSIENT); else sqlite3_bind_null(q, 10);
-        if (sqlite3_step(q) != SQLITE_DONE)
-            st = sl_err_set(err, SL_ERR_INVALID, "catalog: cannot add \"%s\": %s", name, sqlite3_errmsg(db));
+    char now[32];
+    utc_now(now);
+    sl_db_arg args[] = {TEXT(name), TEXT(kind), TEXT(path), TEXT(generator), TEXT(description ? description : ""),
+                        file_size >= 0 ? sl_db_int_arg(file_size) : TEXT(NULL), TEXT(checksum), TEXT(bounds),
+                        TEXT(counts), TEXT(attrs), TEXT(now)};
+#define INSERT_DATASET                                                                                 \
+    "INSERT INTO datasets(name, kind, source_path, generator_json, description, file_size, checksum, bounds," \
+    " counts, attributes, created) VALUES($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)"
+    const char *sql = if_absent ? INSERT_DATASET " ON CONFLICT(name) DO NOTHING" : INSERT_DATASET;
+#undef INSERT_DATASET
+    sl_status st = sl_db_begin(db, 0, err);
+    if (st == SL_OK && sl_db_run(db, sql, args, 11, &changed, err) != SL_OK) {
+        sl_err why = *err;
+        st = sl_err_set(err, SL_ERR_INVALID, "catalog: cannot add \"%s\": %s", name, why.message);
     }
     /* Every insert is deliberate (explicit, or automatic after checking
      * was_removed), so the name is no longer removed. */
+    if (st == SL_OK && changed > 0)
+        st = sl_db_run(db, "DELETE FROM removed WHERE name = $1", args, 1, NULL, err);
     if (st == SL_OK)
-        st = exec_name(db, "DELETE FROM removed WHERE name = ?1", name, err);
-    sqlite3_finalize(q);
+        st = sl_db_commit(db, err); /* rolls back itself when it fails */
+    else
+        sl_db_rollback(db);
+    if (inserted)
+        *inserted = st == SL_OK && changed > 0;
     free(bounds);
     free(counts);
     free(attrs);
@@ -237,12 +179,14 @@ static sl_status insert_dataset(sqlite3 *db, const char *name, const char *kind,
 }
 
 /* Registers the built-ins that are absent; revive=0 skips removed ones. */
-static sl_status register_builtins(sqlite3 *db, int revive, int *added, sl_err *err)
+static sl_status register_builtins(sl_db *db, int revive, int *added, sl_err *err)
 {
     int n = 0;
     const sl_builtin_dataset *b = sl_builtin_datasets(&n);
     for (int i = 0; i < n; i++) {
-        if (name_exists(db, b[i].name) || (!revive && was_removed(db, b[i].name)))
+        /* No check for an existing row: the insert leaves one alone (and a
+         * check would race with another node's start anyway). */
+        if (!revive && was_removed(db, b[i].name))
             continue;
         /* Built-ins are registered without generating them (some take seconds);
          * bounds and counts are filled in when one is first rendered. */
@@ -257,26 +201,27 @@ static sl_status register_builtins(sqlite3 *db, int revive, int *added, sl_err *
         cJSON_Delete(g);
         if (!kind)
             return sl_err_set(err, SL_ERR_INVALID, "built-in dataset \"%s\" names an unknown generator", b[i].name);
+        int inserted = 0;
         sl_status st = insert_dataset(db, b[i].name, kind, NULL, NULL, b[i].generator_json, b[i].description, -1,
-                                      NULL, err);
+                                      NULL, 1, &inserted, err);
         if (st)
             return st;
         if (added)
-            (*added)++;
+            *added += inserted;
     }
     return SL_OK;
 }
 
-sl_status sl_catalog_add_builtins(sqlite3 *db, int *added, sl_err *err)
+sl_status sl_catalog_add_builtins(sl_db *db, int *added, sl_err *err)
 {
     *added = 0;
     return register_builtins(db, 1, added, err);
 }
 
-static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
+static sl_status scan_dir(sl_db *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
                           int *added, sl_err *err);
 
-sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err)
+sl_status sl_catalog_init_defaults(sl_db *db, const char *const *data_dirs, int dir_count, sl_err *err)
 {
     sl_status st = register_builtins(db, 0, NULL, err);
     if (st)
@@ -310,7 +255,7 @@ static sl_status resolve_inside(const char *path, const char *const *dirs, int n
     return sl_err_set(err, SL_ERR_INVALID, "catalog: %s is outside the allowed data directories", path);
 }
 
-static sl_status checksum_file(const char *path, long long *size, char hex[17], sl_err *err)
+sl_status sl_catalog_file_checksum(const char *path, long long *size, char hex[SL_CATALOG_CHECKSUM_SIZE], sl_err *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -331,12 +276,13 @@ static sl_status checksum_file(const char *path, long long *size, char hex[17], 
     if (bad)
         return sl_err_set(err, SL_ERR_IO, "catalog: read error in %s", path);
     *size = total;
-    snprintf(hex, 17, "%016llx", (unsigned long long)h);
+    snprintf(hex, SL_CATALOG_CHECKSUM_SIZE, "%016llx", (unsigned long long)h);
     return SL_OK;
 }
 
-sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *data_dirs, int dir_count,
-                              sl_err *err)
+/* sl_catalog_add_file; if_absent and inserted as for insert_dataset (a scan). */
+static sl_status add_file(sl_db *db, const char *path, const char *const *data_dirs, int dir_count, int if_absent,
+                          int *inserted, sl_err *err)
 {
     char real[PATH_MAX];
     sl_status st = resolve_inside(path, data_dirs, dir_count, real, err);
@@ -347,19 +293,58 @@ sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *
     if (name_exists(db, base) || sl_builtin_lookup(base))
         return sl_err_set(err, SL_ERR_INVALID, "catalog: a dataset named \"%s\" already exists", base);
     long long size = 0;
-    char sum[17];
-    if ((st = checksum_file(real, &size, sum, err)) != SL_OK)
+    char sum[SL_CATALOG_CHECKSUM_SIZE];
+    if ((st = sl_catalog_file_checksum(real, &size, sum, err)) != SL_OK)
         return st;
     sl_dataset *ds = NULL;
     sl_dataset_dirs dirs = {.dirs = data_dirs, .count = dir_count, .confine = 1};
     if ((st = sl_dataset_open(real, &dirs, &ds, err)) != SL_OK)
         return st;
-    st = insert_dataset(db, base, sl_dataset_kind_name(ds->kind), ds, real, NULL, "", size, sum, err);
+    st = insert_dataset(db, base, sl_dataset_kind_name(ds->kind), ds, real, NULL, "", size, sum, if_absent, inserted,
+                        err);
     sl_dataset_destroy(ds);
     return st;
 }
 
-sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *generator_json, sl_err *err)
+sl_status sl_catalog_add_file(sl_db *db, const char *path, const char *const *data_dirs, int dir_count,
+                              sl_err *err)
+{
+    return add_file(db, path, data_dirs, dir_count, 0, NULL, err);
+}
+
+sl_status sl_catalog_refresh_file(sl_db *db, const char *name, const char *const *data_dirs, int dir_count,
+                                  sl_err *err)
+{
+    char source[PATH_MAX], real[PATH_MAX], sum[SL_CATALOG_CHECKSUM_SIZE];
+    int is_file = 0, kind = 0;
+    sl_status st = sl_catalog_lookup(db, name, source, sizeof source, &is_file, &kind, NULL, err);
+    if (st != SL_OK)
+        return st;
+    if (!is_file)
+        return sl_err_set(err, SL_ERR_INVALID, "catalog: \"%s\" is generated, not a file", name);
+    long long size = 0;
+    sl_dataset *ds = NULL;
+    sl_dataset_dirs dirs = {.dirs = data_dirs, .count = dir_count, .confine = 1};
+    if ((st = resolve_inside(source, data_dirs, dir_count, real, err)) != SL_OK ||
+        (st = sl_catalog_file_checksum(real, &size, sum, err)) != SL_OK ||
+        (st = sl_dataset_open(real, &dirs, &ds, err)) != SL_OK)
+        return st;
+    char *bounds = NULL, *counts = NULL, *attrs = NULL;
+    sl_catalog_describe(ds, &bounds, &counts, &attrs);
+    sl_db_arg args[] = {TEXT(name), sl_db_int_arg(size), TEXT(sum), TEXT(bounds), TEXT(counts), TEXT(attrs),
+                        TEXT(sl_dataset_kind_name(ds->kind))};
+    st = sl_db_run(db,
+                   "UPDATE datasets SET file_size = $2, checksum = $3, bounds = $4, counts = $5, attributes = $6,"
+                   " kind = $7 WHERE name = $1",
+                   args, 7, NULL, err);
+    free(bounds);
+    free(counts);
+    free(attrs);
+    sl_dataset_destroy(ds);
+    return st;
+}
+
+sl_status sl_catalog_add_generator(sl_db *db, const char *name, const char *generator_json, sl_err *err)
 {
     if (!name[0] || strlen(name) >= SL_PROTO_NAME_MAX)
         return sl_err_set(err, SL_ERR_INVALID, "catalog: a dataset name must have 1..%d bytes", SL_PROTO_NAME_MAX - 1);
@@ -373,7 +358,7 @@ sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *ge
     char *compact = g ? cJSON_PrintUnformatted(g) : NULL;
     cJSON_Delete(g);
     st = insert_dataset(db, name, sl_dataset_kind_name(ds->kind), ds, NULL, compact ? compact : generator_json,
-                        "", -1, NULL, err);
+                        "", -1, NULL, 0, NULL, err);
     free(compact);
     sl_dataset_destroy(ds);
     return st;
@@ -392,13 +377,13 @@ static int known_extension(const char *name)
     return 0;
 }
 
-sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count,
+sl_status sl_catalog_scan(sl_db *db, const char *dir, const char *const *data_dirs, int dir_count,
                           int *added, sl_err *err)
 {
     return scan_dir(db, dir, data_dirs, dir_count, 1, added, err);
 }
 
-static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
+static sl_status scan_dir(sl_db *db, const char *dir, const char *const *data_dirs, int dir_count, int revive,
                           int *added, sl_err *err)
 {
     *added = 0;
@@ -419,8 +404,9 @@ static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_
             (!revive && was_removed(db, e->d_name)))
             continue;
         sl_err one = {0};
-        if (sl_catalog_add_file(db, path, data_dirs, dir_count, &one) == SL_OK)
-            (*added)++;
+        int inserted = 0;
+        if (add_file(db, path, data_dirs, dir_count, 1, &inserted, &one) == SL_OK)
+            *added += inserted;
         else
             fprintf(stderr, "sightline-server: skipped %s: %s\n", path, one.message);
     }
@@ -428,340 +414,321 @@ static sl_status scan_dir(sqlite3 *db, const char *dir, const char *const *data_
     return SL_OK;
 }
 
-sl_status sl_catalog_set_info(sqlite3 *db, const char *name, const char *bounds, const char *counts,
-                               const char *attrs, sl_err *err)
+sl_status sl_catalog_set_info(sl_db *db, const char *name, const char *bounds, const char *counts,
+                              const char *attrs, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
     /* Fills a row not described yet, and refreshes a volume described before
-     * catalogs kept histograms (a catalog file from an older version). */
-    if (sqlite3_prepare_v2(db, "UPDATE datasets SET bounds = ?2, counts = ?3, attributes = ?4"
-                               " WHERE name = ?1 AND (bounds IS NULL OR (kind <> 'lines' AND"
-                               " json_type(counts, '$.histogram') IS NULL))", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare set_info");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 2, bounds, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 3, counts, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 4, attrs, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "set_info");
+     * catalogs kept histograms (a catalog from an older version). */
+    sl_db_result *r = NULL;
+    sl_db_arg args[] = {TEXT(name), TEXT(bounds), TEXT(counts), TEXT(attrs)};
+    sl_status st = sl_db_query(db, "SELECT kind, bounds, counts FROM datasets WHERE name = $1", args, 1, &r, err);
+    if (st != SL_OK || sl_db_result_rows(r) == 0) {
+        sl_db_result_destroy(r);
+        return st;
+    }
+    const char *kind = sl_db_text(r, 0, 0), *old_counts = sl_db_text(r, 0, 2);
+    cJSON *c = old_counts ? cJSON_Parse(old_counts) : NULL;
+    int stale = !sl_db_text(r, 0, 1) ||
+                (kind && strcmp(kind, "lines") != 0 && !cJSON_GetObjectItemCaseSensitive(c, "histogram"));
+    cJSON_Delete(c);
+    sl_db_result_destroy(r);
+    if (!stale)
+        return SL_OK;
+    return sl_db_run(db, "UPDATE datasets SET bounds = $2, counts = $3, attributes = $4 WHERE name = $1", args, 4,
+                     NULL, err);
 }
 
-sl_status sl_catalog_remove(sqlite3 *db, const char *name, sl_err *err)
+sl_status sl_catalog_remove(sl_db *db, const char *name, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "DELETE FROM datasets WHERE name = ?1", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare delete");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    if (rc != SQLITE_DONE)
-        return db_fail(db, err, "delete");
-    if (sqlite3_changes(db) == 0)
-        return sl_err_set(err, SL_ERR_INVALID, "catalog: no dataset named \"%s\"", name);
-    return exec_name(db, "INSERT OR REPLACE INTO removed(name) VALUES(?1)", name, err);
+    char now[32];
+    utc_now(now);
+    sl_db_arg args[] = {TEXT(name), TEXT(now)};
+    long long changed = 0;
+    sl_status st = sl_db_begin(db, 0, err);
+    if (st == SL_OK)
+        st = sl_db_run(db, "DELETE FROM datasets WHERE name = $1", args, 1, &changed, err);
+    if (st == SL_OK && changed == 0)
+        st = sl_err_set(err, SL_ERR_INVALID, "catalog: no dataset named \"%s\"", name);
+    if (st == SL_OK)
+        st = sl_db_run(db,
+                       "INSERT INTO removed(name, removed) VALUES($1, $2)"
+                       " ON CONFLICT(name) DO UPDATE SET removed = excluded.removed",
+                       args, 2, NULL, err);
+    if (st == SL_OK)
+        return sl_db_commit(db, err);
+    sl_db_rollback(db);
+    return st;
 }
 
-static cJSON *column_json(sqlite3_stmt *q, int col)
+/* The cell parsed as JSON, or JSON null. */
+static cJSON *cell_json(const sl_db_result *r, int row, int col)
 {
-    const unsigned char *t = sqlite3_column_text(q, col);
-    cJSON *j = t ? cJSON_Parse((const char *)t) : NULL;
+    const char *t = sl_db_text(r, row, col);
+    cJSON *j = t ? cJSON_Parse(t) : NULL;
     return j ? j : cJSON_CreateNull();
 }
 
-cJSON *sl_catalog_list_json(sqlite3 *db, int with_paths)
+/* Adds the cell as a string member; NULL cells are left out unless fallback is given. */
+static void add_text(cJSON *o, const char *key, const sl_db_result *r, int row, int col, const char *fallback)
+{
+    const char *t = sl_db_text(r, row, col);
+    if (t || fallback)
+        cJSON_AddStringToObject(o, key, t ? t : fallback);
+}
+
+cJSON *sl_catalog_list_json(sl_db *db, int with_paths)
 {
     cJSON *arr = cJSON_CreateArray();
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db,
-                           "SELECT name, kind, source_path, generator_json, description, file_size, checksum,"
-                           " bounds, counts, attributes, created FROM datasets ORDER BY id",
-                           -1, &q, NULL) != SQLITE_OK)
+    sl_db_result *r = NULL;
+    sl_err err = {0};
+    if (sl_db_query(db,
+                    "SELECT name, kind, source_path, generator_json, description, file_size, checksum,"
+                    " bounds, counts, attributes, created FROM datasets ORDER BY id",
+                    NULL, 0, &r, &err) != SL_OK) {
+        fprintf(stderr, "sightline-server: %s\n", err.message);
         return arr;
-    while (sqlite3_step(q) == SQLITE_ROW) {
+    }
+    for (int i = 0; i < sl_db_result_rows(r); i++) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
-        cJSON_AddStringToObject(o, "kind", (const char *)sqlite3_column_text(q, 1));
-        if (sqlite3_column_type(q, 2) != SQLITE_NULL) {
+        add_text(o, "name", r, i, 0, "");
+        add_text(o, "kind", r, i, 1, "");
+        if (sl_db_text(r, i, 2)) {
             if (with_paths)
-                cJSON_AddStringToObject(o, "path", (const char *)sqlite3_column_text(q, 2));
+                add_text(o, "path", r, i, 2, NULL);
             cJSON_AddStringToObject(o, "source", "file");
         } else {
             cJSON_AddStringToObject(o, "source", "generator");
         }
-        if (sqlite3_column_type(q, 3) != SQLITE_NULL)
-            cJSON_AddItemToObject(o, "generator", column_json(q, 3));
-        cJSON_AddStringToObject(o, "description",
-                                sqlite3_column_text(q, 4) ? (const char *)sqlite3_column_text(q, 4) : "");
-        if (sqlite3_column_type(q, 5) != SQLITE_NULL)
-            cJSON_AddNumberToObject(o, "file_size", (double)sqlite3_column_int64(q, 5));
-        if (sqlite3_column_type(q, 6) != SQLITE_NULL)
-            cJSON_AddStringToObject(o, "checksum", (const char *)sqlite3_column_text(q, 6));
-        cJSON_AddItemToObject(o, "bounds", column_json(q, 7));
-        cJSON_AddItemToObject(o, "counts", column_json(q, 8));
-        cJSON_AddItemToObject(o, "attributes", column_json(q, 9));
-        cJSON_AddStringToObject(o, "created", (const char *)sqlite3_column_text(q, 10));
+        if (sl_db_text(r, i, 3))
+            cJSON_AddItemToObject(o, "generator", cell_json(r, i, 3));
+        add_text(o, "description", r, i, 4, "");
+        if (sl_db_text(r, i, 5))
+            cJSON_AddNumberToObject(o, "file_size", (double)sl_db_int(r, i, 5, 0));
+        add_text(o, "checksum", r, i, 6, NULL);
+        cJSON_AddItemToObject(o, "bounds", cell_json(r, i, 7));
+        cJSON_AddItemToObject(o, "counts", cell_json(r, i, 8));
+        cJSON_AddItemToObject(o, "attributes", cell_json(r, i, 9));
+        add_text(o, "created", r, i, 10, "");
         cJSON_AddItemToArray(arr, o);
     }
-    sqlite3_finalize(q);
+    sl_db_result_destroy(r);
     return arr;
 }
 
-sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t source_size, int *is_file,
-                            int *kind, sl_err *err)
+sl_status sl_catalog_lookup(sl_db *db, const char *name, char *source, size_t source_size, int *is_file,
+                            int *kind, char checksum[SL_CATALOG_CHECKSUM_SIZE], sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT kind, source_path, generator_json FROM datasets WHERE name = ?1", -1, &q,
-                           NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare lookup");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    sl_status st = SL_OK;
-    if (sqlite3_step(q) != SQLITE_ROW) {
-        st = sl_err_set(err, SL_ERR_INVALID, "no dataset named \"%s\" in the catalog", name);
-    } else {
-        const char *k = (const char *)sqlite3_column_text(q, 0);
-        *kind = 0;
-        for (int i = 0; i < SL_DATASET_KIND_COUNT; i++)
-            if (k && strcmp(k, sl_dataset_kind_name(sl_dataset_kinds[i])) == 0)
-                *kind = sl_dataset_kinds[i];
-        const char *path = (const char *)sqlite3_column_text(q, 1);
-        const char *gen = (const char *)sqlite3_column_text(q, 2);
-        *is_file = path != NULL;
-        const char *src = path ? path : gen;
-        if (!src || strlen(src) >= source_size)
-            st = sl_err_set(err, SL_ERR_LIMIT, "dataset \"%s\" has no usable source (or one over %zu bytes)", name,
-                            source_size);
-        else
-            memcpy(source, src, strlen(src) + 1);
+    sl_db_result *r = NULL;
+    sl_db_arg arg = TEXT(name);
+    sl_status st = sl_db_query(db, "SELECT kind, source_path, generator_json, checksum FROM datasets WHERE name = $1",
+                               &arg, 1, &r, err);
+    if (st != SL_OK)
+        return st;
+    if (sl_db_result_rows(r) == 0) {
+        sl_db_result_destroy(r);
+        return sl_err_set(err, SL_ERR_INVALID, "no dataset named \"%s\" in the catalog", name);
     }
-    sqlite3_finalize(q);
+    const char *k = sl_db_text(r, 0, 0), *path = sl_db_text(r, 0, 1), *gen = sl_db_text(r, 0, 2);
+    const char *sum = sl_db_text(r, 0, 3);
+    *kind = 0;
+    for (int i = 0; i < SL_DATASET_KIND_COUNT; i++)
+        if (k && strcmp(k, sl_dataset_kind_name(sl_dataset_kinds[i])) == 0)
+            *kind = sl_dataset_kinds[i];
+    *is_file = path != NULL;
+    if (checksum)
+        snprintf(checksum, SL_CATALOG_CHECKSUM_SIZE, "%s", path && sum ? sum : "");
+    const char *src = path ? path : gen;
+    if (!src || strlen(src) >= source_size)
+        st = sl_err_set(err, SL_ERR_LIMIT, "dataset \"%s\" has no usable source (or one over %zu bytes)", name,
+                        source_size);
+    else
+        memcpy(source, src, strlen(src) + 1);
+    sl_db_result_destroy(r);
     return st;
 }
 
-/* The rows of a named table (count_sql: "SELECT COUNT(*), SUM(name = ?1)
- * FROM t") and whether `name` is among them: the caps of saved views and
- * paths (a new name only below the cap, a replacement always). */
-static sl_status count_named(sqlite3 *db, const char *count_sql, const char *name, long long *count,
-                             int *exists, sl_err *err)
+/* Inside the caller's transaction: SL_ERR_LIMIT when `name` is new and the
+ * table (views or paths) already holds `cap` rows. */
+static sl_status check_cap(sl_db *db, const char *table, const char *name, int cap, const char *what, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    *count = 0;
-    *exists = 0;
-    if (sqlite3_prepare_v2(db, count_sql, -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare count");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(q) == SQLITE_ROW) {
-        *count = sqlite3_column_int64(q, 0);
-        *exists = sqlite3_column_int64(q, 1) > 0;
-    }
-    sqlite3_finalize(q);
-    return SL_OK;
+    char sql[160];
+    snprintf(sql, sizeof sql, "SELECT COUNT(*), SUM(CASE WHEN name = $1 THEN 1 ELSE 0 END) FROM %s", table);
+    sl_db_result *r = NULL;
+    sl_db_arg arg = TEXT(name);
+    sl_status st = sl_db_query(db, sql, &arg, 1, &r, err);
+    if (st == SL_OK && sl_db_int(r, 0, 1, 0) == 0 && sl_db_int(r, 0, 0, 0) >= cap)
+        st = sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved %s (the limit); reuse a name", cap,
+                        what);
+    sl_db_result_destroy(r);
+    return st;
 }
 
-sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *dataset, const char *technique,
+/* Runs a capped upsert (check_cap, then sql over args) in one transaction. */
+static sl_status capped_upsert(sl_db *db, const char *table, int cap, const char *what, const char *sql,
+                               const sl_db_arg *args, int nargs, sl_err *err)
+{
+    sl_status st = sl_db_begin(db, 0, err);
+    if (st != SL_OK)
+        return st;
+    if ((st = check_cap(db, table, args[0].text, cap, what, err)) == SL_OK &&
+        (st = sl_db_run(db, sql, args, nargs, NULL, err)) == SL_OK)
+        return sl_db_commit(db, err);
+    sl_db_rollback(db);
+    return st;
+}
+
+sl_status sl_catalog_save_view(sl_db *db, const char *name, const char *dataset, const char *technique,
                                const char *params_json, const char *camera_json, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    /* Replacing a view is always allowed; a new name only below the cap. */
-    long long count = 0;
-    int exists = 0;
-    sl_status cst = count_named(db, "SELECT COUNT(*), SUM(name = ?1) FROM views", name, &count, &exists, err);
-    if (cst != SL_OK)
-        return cst;
-    if (!exists && count >= SL_CATALOG_MAX_VIEWS)
-        return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved views (the limit); reuse a name",
-                          SL_CATALOG_MAX_VIEWS);
-    if (sqlite3_prepare_v2(db,
-                           "INSERT INTO views(name, dataset, technique, params, camera) VALUES(?1, ?2, ?3, ?4, ?5)"
-                           " ON CONFLICT(name) DO UPDATE SET dataset = excluded.dataset,"
-                           " technique = excluded.technique, params = excluded.params, camera = excluded.camera",
-                           -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare save_view");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 2, dataset, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 3, technique, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 4, params_json, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 5, camera_json, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "save_view");
+    char now[32];
+    utc_now(now);
+    sl_db_arg args[] = {TEXT(name), TEXT(dataset), TEXT(technique), TEXT(params_json), TEXT(camera_json), TEXT(now)};
+    return capped_upsert(db, "views", SL_CATALOG_MAX_VIEWS, "views",
+                         "INSERT INTO views(name, dataset, technique, params, camera, created)"
+                         " VALUES($1, $2, $3, $4, $5, $6)"
+                         " ON CONFLICT(name) DO UPDATE SET dataset = excluded.dataset,"
+                         " technique = excluded.technique, params = excluded.params, camera = excluded.camera",
+                         args, 6, err);
 }
 
-sl_status sl_catalog_load_view(sqlite3 *db, const char *name, cJSON **view, sl_err *err)
+sl_status sl_catalog_load_view(sl_db *db, const char *name, cJSON **view, sl_err *err)
 {
     *view = NULL;
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT name, dataset, technique, params, camera FROM views WHERE name = ?1", -1, &q,
-                           NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare load_view");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(q) == SQLITE_ROW) {
+    sl_db_result *r = NULL;
+    sl_db_arg arg = TEXT(name);
+    sl_status st = sl_db_query(db, "SELECT name, dataset, technique, params, camera FROM views WHERE name = $1",
+                               &arg, 1, &r, err);
+    if (st == SL_OK && sl_db_result_rows(r) > 0) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
-        cJSON_AddStringToObject(o, "dataset", (const char *)sqlite3_column_text(q, 1));
-        cJSON_AddStringToObject(o, "technique", (const char *)sqlite3_column_text(q, 2));
-        cJSON_AddItemToObject(o, "params", column_json(q, 3));
-        cJSON_AddItemToObject(o, "camera", column_json(q, 4));
+        add_text(o, "name", r, 0, 0, "");
+        add_text(o, "dataset", r, 0, 1, "");
+        add_text(o, "technique", r, 0, 2, "");
+        cJSON_AddItemToObject(o, "params", cell_json(r, 0, 3));
+        cJSON_AddItemToObject(o, "camera", cell_json(r, 0, 4));
         *view = o;
     }
-    sqlite3_finalize(q);
-    return SL_OK;
+    sl_db_result_destroy(r);
+    return st;
 }
 
-cJSON *sl_catalog_list_views_json(sqlite3 *db)
+cJSON *sl_catalog_list_views_json(sl_db *db)
 {
     cJSON *arr = cJSON_CreateArray();
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT name, dataset, technique, created FROM views ORDER BY name", -1, &q, NULL)
-        != SQLITE_OK)
-        return arr;
-    while (sqlite3_step(q) == SQLITE_ROW) {
+    sl_db_result *r = NULL;
+    sl_err err = {0};
+    if (sl_db_query(db, "SELECT name, dataset, technique, created FROM views ORDER BY name", NULL, 0, &r, &err) !=
+        SL_OK)
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+    for (int i = 0; i < sl_db_result_rows(r); i++) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
-        cJSON_AddStringToObject(o, "dataset", (const char *)sqlite3_column_text(q, 1));
-        cJSON_AddStringToObject(o, "technique", (const char *)sqlite3_column_text(q, 2));
-        cJSON_AddStringToObject(o, "created", (const char *)sqlite3_column_text(q, 3));
+        add_text(o, "name", r, i, 0, "");
+        add_text(o, "dataset", r, i, 1, "");
+        add_text(o, "technique", r, i, 2, "");
+        add_text(o, "created", r, i, 3, "");
         cJSON_AddItemToArray(arr, o);
     }
-    sqlite3_finalize(q);
+    sl_db_result_destroy(r);
     return arr;
 }
 
-sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *technique, const char *path_json,
+sl_status sl_catalog_save_path(sl_db *db, const char *name, const char *technique, const char *path_json,
                                int keys, double duration, sl_err *err)
 {
     size_t bytes = strlen(path_json);
     if (bytes > SL_CATALOG_MAX_PATH_BYTES)
         return sl_err_set(err, SL_ERR_LIMIT, "path: %zu bytes of JSON; a saved path holds at most %d", bytes,
                           SL_CATALOG_MAX_PATH_BYTES);
-    sqlite3_stmt *q = NULL;
-    long long count = 0;
-    int exists = 0;
-    sl_status cst = count_named(db, "SELECT COUNT(*), SUM(name = ?1) FROM paths", name, &count, &exists, err);
-    if (cst != SL_OK)
-        return cst;
-    if (!exists && count >= SL_CATALOG_MAX_PATHS)
-        return sl_err_set(err, SL_ERR_LIMIT, "the catalog already holds %d saved paths (the limit); reuse a name",
-                          SL_CATALOG_MAX_PATHS);
-    if (sqlite3_prepare_v2(db,
-                           "INSERT INTO paths(name, technique, path, keys, duration) VALUES(?1, ?2, ?3, ?4, ?5)"
-                           " ON CONFLICT(name) DO UPDATE SET technique = excluded.technique, path = excluded.path,"
-                           " keys = excluded.keys, duration = excluded.duration",
-                           -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare save_path");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 2, technique, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 3, path_json, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_int(q, 4, keys);
-    sqlite3_bind_double(q, 5, duration);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "save_path");
+    char now[32];
+    utc_now(now);
+    sl_db_arg args[] = {TEXT(name), TEXT(technique), TEXT(path_json), sl_db_int_arg(keys), sl_db_real_arg(duration),
+                        TEXT(now)};
+    return capped_upsert(db, "paths", SL_CATALOG_MAX_PATHS, "paths",
+                         "INSERT INTO paths(name, technique, path, keys, duration, created)"
+                         " VALUES($1, $2, $3, $4, $5, $6)"
+                         " ON CONFLICT(name) DO UPDATE SET technique = excluded.technique, path = excluded.path,"
+                         " keys = excluded.keys, duration = excluded.duration",
+                         args, 6, err);
 }
 
-sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err)
+sl_status sl_catalog_load_path(sl_db *db, const char *name, cJSON **path, sl_err *err)
 {
     *path = NULL;
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT path FROM paths WHERE name = ?1", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare load_path");
-    sqlite3_bind_text(q, 1, name, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(q) == SQLITE_ROW)
-        *path = column_json(q, 0);
-    sqlite3_finalize(q);
-    return SL_OK;
+    sl_db_result *r = NULL;
+    sl_db_arg arg = TEXT(name);
+    sl_status st = sl_db_query(db, "SELECT path FROM paths WHERE name = $1", &arg, 1, &r, err);
+    if (st == SL_OK && sl_db_result_rows(r) > 0)
+        *path = cell_json(r, 0, 0);
+    sl_db_result_destroy(r);
+    return st;
 }
 
-cJSON *sl_catalog_list_paths_json(sqlite3 *db)
+cJSON *sl_catalog_list_paths_json(sl_db *db)
 {
     cJSON *arr = cJSON_CreateArray();
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT name, technique, keys, duration, created FROM paths ORDER BY name", -1, &q,
-                           NULL) != SQLITE_OK)
-        return arr;
-    while (sqlite3_step(q) == SQLITE_ROW) {
+    sl_db_result *r = NULL;
+    sl_err err = {0};
+    if (sl_db_query(db, "SELECT name, technique, keys, duration, created FROM paths ORDER BY name", NULL, 0, &r,
+                    &err) != SL_OK)
+        fprintf(stderr, "sightline-server: %s\n", err.message);
+    for (int i = 0; i < sl_db_result_rows(r); i++) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", (const char *)sqlite3_column_text(q, 0));
-        cJSON_AddStringToObject(o, "technique", (const char *)sqlite3_column_text(q, 1));
-        cJSON_AddNumberToObject(o, "keys", sqlite3_column_int(q, 2));
-        cJSON_AddNumberToObject(o, "duration", sqlite3_column_double(q, 3));
-        cJSON_AddStringToObject(o, "created", (const char *)sqlite3_column_text(q, 4));
+        add_text(o, "name", r, i, 0, "");
+        add_text(o, "technique", r, i, 1, "");
+        cJSON_AddNumberToObject(o, "keys", (double)sl_db_int(r, i, 2, 0));
+        cJSON_AddNumberToObject(o, "duration", sl_db_real(r, i, 3, 0));
+        add_text(o, "created", r, i, 4, "");
         cJSON_AddItemToArray(arr, o);
     }
-    sqlite3_finalize(q);
+    sl_db_result_destroy(r);
     return arr;
 }
 
-sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *node, const char *token_hash,
+sl_status sl_catalog_session_put(sl_db *db, const char *id, const char *node, const char *token_hash,
                                  const char *state_json, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db,
-                           "INSERT INTO sessions(id, node, token_hash, state) VALUES(?1, ?2, ?3, ?4)"
-                           " ON CONFLICT(id) DO UPDATE SET node = excluded.node, token_hash = excluded.token_hash,"
-                           " state = excluded.state, updated = strftime('%Y-%m-%dT%H:%M:%SZ','now')",
-                           -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare session_put");
-    sqlite3_bind_text(q, 1, id, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 2, node, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 3, token_hash, -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(q, 4, state_json, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "session_put");
+    char now[32];
+    utc_now(now);
+    sl_db_arg args[] = {TEXT(id), TEXT(node), TEXT(token_hash), TEXT(state_json), TEXT(now)};
+    return sl_db_run(db,
+                     "INSERT INTO sessions(id, node, token_hash, state, created, updated) VALUES($1, $2, $3, $4, $5, $5)"
+                     " ON CONFLICT(id) DO UPDATE SET node = excluded.node, token_hash = excluded.token_hash,"
+                     " state = excluded.state, updated = excluded.updated",
+                     args, 5, NULL, err);
 }
 
-sl_status sl_catalog_session_get(sqlite3 *db, const char *id, char **state_json, char token_hash[65], char *node,
+sl_status sl_catalog_session_get(sl_db *db, const char *id, char **state_json, char token_hash[65], char *node,
                                  size_t node_size, sl_err *err)
 {
     *state_json = NULL;
     token_hash[0] = '\0';
     if (node_size)
         node[0] = '\0';
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT state, token_hash, node FROM sessions WHERE id = ?1", -1, &q, NULL) !=
-        SQLITE_OK)
-        return db_fail(db, err, "prepare session_get");
-    sqlite3_bind_text(q, 1, id, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sl_status st = SL_OK;
-    if (rc == SQLITE_ROW) {
-        const char *state = (const char *)sqlite3_column_text(q, 0);
-        const char *hash = (const char *)sqlite3_column_text(q, 1);
-        const char *owner = (const char *)sqlite3_column_text(q, 2);
+    sl_db_result *r = NULL;
+    sl_db_arg arg = TEXT(id);
+    sl_status st = sl_db_query(db, "SELECT state, token_hash, node FROM sessions WHERE id = $1", &arg, 1, &r, err);
+    if (st == SL_OK && sl_db_result_rows(r) == 0)
+        st = sl_err_set(err, SL_ERR_INVALID, "catalog: no checkpoint of session %s", id);
+    if (st == SL_OK) {
+        const char *state = sl_db_text(r, 0, 0), *hash = sl_db_text(r, 0, 1), *owner = sl_db_text(r, 0, 2);
         *state_json = strdup(state ? state : "");
         snprintf(token_hash, 65, "%s", hash ? hash : "");
         if (node_size)
             snprintf(node, node_size, "%s", owner ? owner : "");
         if (!*state_json)
             st = sl_err_set(err, SL_ERR_NOMEM, "catalog: out of memory reading the checkpoint of %s", id);
-    } else if (rc == SQLITE_DONE) {
-        st = sl_err_set(err, SL_ERR_INVALID, "catalog: no checkpoint of session %s", id);
-    } else {
-        st = db_fail(db, err, "session_get");
     }
-    sqlite3_finalize(q);
+    sl_db_result_destroy(r);
     return st;
 }
 
-sl_status sl_catalog_sessions_clear_node(sqlite3 *db, const char *node, sl_err *err)
+sl_status sl_catalog_sessions_clear_node(sl_db *db, const char *node, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "DELETE FROM sessions WHERE node = ?1", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare sessions_clear_node");
-    sqlite3_bind_text(q, 1, node, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "sessions_clear_node");
+    sl_db_arg arg = TEXT(node);
+    return sl_db_run(db, "DELETE FROM sessions WHERE node = $1", &arg, 1, NULL, err);
 }
 
-sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err)
+sl_status sl_catalog_session_remove(sl_db *db, const char *id, sl_err *err)
 {
-    sqlite3_stmt *q = NULL;
-    if (sqlite3_prepare_v2(db, "DELETE FROM sessions WHERE id = ?1", -1, &q, NULL) != SQLITE_OK)
-        return db_fail(db, err, "prepare session_remove");
-    sqlite3_bind_text(q, 1, id, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(q);
-    sqlite3_finalize(q);
-    return rc == SQLITE_DONE ? SL_OK : db_fail(db, err, "session_remove");
+    sl_db_arg arg = TEXT(id);
+    return sl_db_run(db, "DELETE FROM sessions WHERE id = $1", &arg, 1, NULL, err);
 }

@@ -124,7 +124,7 @@ sl_status sl_checkpoint_restore_state(sl_server *srv, const char *state_json, sl
         goto done;
     }
     if ((rc = sl_catalog_lookup(srv->db, ds->valuestring, st->dataset_source, sizeof st->dataset_source,
-                                &st->dataset_is_file, &st->dataset_kind, err)) != SL_OK)
+                                &st->dataset_is_file, &st->dataset_kind, st->dataset_checksum, err)) != SL_OK)
         goto done;
     if (!(t->dataset_kinds & (unsigned)st->dataset_kind)) {
         rc = sl_err_set(err, SL_ERR_INVALID, "technique %s cannot render the session's dataset", t->name);

@@ -13,7 +13,10 @@
  * A failed load is not cached: the next request tries again. A cached file
  * is used only while the file on disk is the one loaded (same inode, size
  * and modification time), so a rewritten file is reloaded and a vanished one
- * fails as it would without the cache. Each owner of a dataset (the cache,
+ * fails as it would without the cache. A file registered with a checksum is
+ * checked against it on the loader thread before it is parsed, and a cache
+ * entry serves only requests for the checksum it was verified with (or
+ * none). Each owner of a dataset (the cache,
  * a load's result, every pipeline) holds a reference (sl_dataset_retain).
  * Threads: any caller thread (the render thread) and the loaders; every
  * field below is guarded by `lock`. Lock order: a caller may hold its own
@@ -43,6 +46,7 @@ struct sl_dataset_load {
     enum load_state state;
     char source[SL_SOURCE_MAX];  /* immutable */
     int is_file;
+    char checksum[SL_CATALOG_CHECKSUM_SIZE]; /* immutable; "" none */
     uint64_t stamp[4];           /* the file's identity when requested */
     sl_status status;            /* LOAD_DONE: the result */
     sl_err err;
@@ -62,6 +66,7 @@ struct sl_dataset_cache {
         sl_dataset *dataset;  /* one reference, NULL when empty */
         uint64_t used;        /* clock of the last use */
         uint64_t stamp[4];    /* files: inode, size, mtime s/ns when loaded */
+        char checksum[SL_CATALOG_CHECKSUM_SIZE]; /* what the file was checked against; "" none */
     } slot[SL_DATASET_CACHE_SLOTS];
     sl_dataset_load *queue;       /* queued and running loads, oldest first */
     uint64_t clock;
@@ -104,7 +109,8 @@ static void free_load(sl_dataset_load *l)
 }
 
 /* Keeps ds (a new reference) for source; lock held. */
-static void insert_locked(sl_dataset_cache *c, const char *source, const uint64_t stamp[4], sl_dataset *ds)
+static void insert_locked(sl_dataset_cache *c, const char *source, const uint64_t stamp[4], const char *checksum,
+                          sl_dataset *ds)
 {
     if (strlen(source) >= sizeof c->slot[0].source)
         return; /* too long a key to keep; its waiters own their copies alone */
@@ -120,8 +126,28 @@ static void insert_locked(sl_dataset_cache *c, const char *source, const uint64_
     drop_slot(c, victim);
     c->slot[victim].dataset = sl_dataset_retain(ds);
     memcpy(c->slot[victim].stamp, stamp, sizeof c->slot[victim].stamp);
+    snprintf(c->slot[victim].checksum, sizeof c->slot[victim].checksum, "%s", checksum);
     c->slot[victim].used = ++c->clock;
     snprintf(c->slot[victim].source, sizeof c->slot[victim].source, "%s", source);
+}
+
+/* SL_OK when the file's bytes have the checksum the catalog registered (or none is known). */
+static sl_status check_file(const char *path, const char *want, sl_err *err)
+{
+    if (!want[0])
+        return SL_OK;
+    long long size = 0;
+    char have[SL_CATALOG_CHECKSUM_SIZE];
+    sl_status st = sl_catalog_file_checksum(path, &size, have, err);
+    if (st == SL_OK && strcmp(have, want) != 0) {
+        const char *base = strrchr(path, '/');
+        st = sl_err_set(err, SL_ERR_INVALID,
+                        "the file %s on this node is not the one the catalog registered (checksum %s, catalog %s): "
+                        "every node must read the same data directory; after a deliberate change run "
+                        "`sightline-server catalog refresh NAME`",
+                        base ? base + 1 : path, have, want);
+    }
+    return st;
 }
 
 static void sleep_ms(double ms)
@@ -154,7 +180,9 @@ static void *loader_main(void *arg)
         /* Files confined to the data directories (the catalog resolved them there; a
          * file swapped for a symlink since is refused), generator JSON as it is. */
         sl_dataset_dirs dirs = {.dirs = c->desc.data_dirs, .count = c->desc.data_dir_count, .confine = 1};
-        sl_status rc = sl_dataset_open(l->source, l->is_file ? &dirs : NULL, &ds, &err);
+        sl_status rc = l->is_file ? check_file(l->source, l->checksum, &err) : SL_OK;
+        if (rc == SL_OK)
+            rc = sl_dataset_open(l->source, l->is_file ? &dirs : NULL, &ds, &err);
         double ms = sl_clock_ms() - t0;
         pthread_mutex_lock(&c->lock);
         l->status = rc;
@@ -164,7 +192,7 @@ static void *loader_main(void *arg)
         l->state = LOAD_DONE;
         unlink_load(c, l);
         if (rc == SL_OK)
-            insert_locked(c, l->source, l->stamp, ds);
+            insert_locked(c, l->source, l->stamp, l->checksum, ds);
         if (--l->refs == 0)
             free_load(l);
         pthread_mutex_unlock(&c->lock);
@@ -222,17 +250,20 @@ void sl_dataset_cache_destroy(sl_dataset_cache *c)
     free(c);
 }
 
-sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int is_file, sl_dataset **out,
-                                   sl_dataset_load **load, sl_dataset_origin *origin, sl_err *err)
+sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int is_file, const char *checksum,
+                                   sl_dataset **out, sl_dataset_load **load, sl_dataset_origin *origin, sl_err *err)
 {
     *out = NULL;
     *load = NULL;
+    if (!is_file || !checksum)
+        checksum = "";
     uint64_t stamp[4] = {0};
     if (is_file)
         file_stamp(source, stamp);
     pthread_mutex_lock(&c->lock);
     for (int i = 0; i < SL_DATASET_CACHE_SLOTS; i++) {
-        if (!c->slot[i].dataset || strcmp(c->slot[i].source, source) != 0)
+        if (!c->slot[i].dataset || strcmp(c->slot[i].source, source) != 0 ||
+            (checksum[0] && strcmp(c->slot[i].checksum, checksum) != 0))
             continue;
         if (memcmp(c->slot[i].stamp, stamp, sizeof stamp) != 0) {
             drop_slot(c, i); /* the file changed or vanished: load it again */
@@ -245,7 +276,8 @@ sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int 
         return SL_OK;
     }
     for (sl_dataset_load *l = c->queue; l; l = l->next)
-        if (strcmp(l->source, source) == 0 && l->is_file == is_file && memcmp(l->stamp, stamp, sizeof stamp) == 0) {
+        if (strcmp(l->source, source) == 0 && l->is_file == is_file && strcmp(l->checksum, checksum) == 0 &&
+            memcmp(l->stamp, stamp, sizeof stamp) == 0) {
             l->refs++;
             *load = l;
             *origin = SL_DATASET_SHARED_LOAD;
@@ -261,6 +293,7 @@ sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int 
     }
     snprintf(l->source, sizeof l->source, "%s", source);
     l->is_file = is_file;
+    snprintf(l->checksum, sizeof l->checksum, "%s", checksum);
     memcpy(l->stamp, stamp, sizeof stamp);
     l->refs = 2; /* the caller, the queue */
     sl_dataset_load **tail = &c->queue;

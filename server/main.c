@@ -1,14 +1,16 @@
 /* main.c — sightline-server: arguments, the `catalog` subcommand, start and orderly stop.
  *
- *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH] [--data-dir DIR]...
+ *   sightline-server [--port 8080] [--bind 127.0.0.1] [--db PATH|URL] [--data-dir DIR]...
  *                    [--web-dir DIR] [--allow-origin URL]... [--max-clients N]
  *                    [--max-pending N] [--max-pending-per-address N]
  *                    [--max-sessions N] [--grace S] [--idle-release S] [--egl-device D]
  *                    [--default-dataset NAME] [--hello-timeout S] [--node-id NAME] [--agent-port P]
  *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS]
  *                    [--test-load-delay-ms MS]   (the --test-* options are for tests only)
- *   sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
- *                    | remove NAME | scan DIR | add-builtins
+ *   sightline-server [--db PATH|URL] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
+ *                    | remove NAME | refresh NAME | scan DIR | add-builtins
+ * --db is an SQLite file (default ~/.local/share/sightline/catalog.db) or a
+ * postgresql:// URL: one catalog that several render nodes share.
  * (options may also follow the subcommand).
  *
  * The work is elsewhere (see sl_server.h for the map): this file opens the
@@ -71,7 +73,7 @@ static void default_node_id(char out[SL_NODE_ID_MAX + 1])
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: sightline-server [--port N] [--bind ADDR] [--db PATH] [--data-dir DIR]... [--web-dir DIR]\n"
+            "usage: sightline-server [--port N] [--bind ADDR] [--db PATH|URL] [--data-dir DIR]... [--web-dir DIR]\n"
             "                        [--allow-origin URL]... [--max-clients N] [--max-pending N]\n"
             "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--idle-release SECONDS] [--egl-device software|INDEX] [--default-dataset NAME]\n"
@@ -80,9 +82,13 @@ static void usage(FILE *f)
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
             "                        frame's render, and MS before every dataset load, so a scene is slow in a\n"
             "                        known way)\n"
-            "       sightline-server [--db PATH] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list\n"
-            "                        | remove NAME | scan DIR | add-builtins\n"
-            "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back)\n"
+            "       sightline-server [--db PATH|URL] [--data-dir DIR] catalog add PATH | add-generator NAME JSON\n"
+            "                        | list | remove NAME | refresh NAME | scan DIR | add-builtins\n"
+            "       (a removed dataset stays removed; `add`, `scan` or `add-builtins` brings it back;\n"
+            "       `refresh` records a deliberately changed file's new checksum)\n"
+            "  --db PATH|URL     the catalog: an SQLite file (one machine; default\n"
+            "                    ~/.local/share/sightline/catalog.db) or postgresql://USER@HOST:PORT/DB, one\n"
+            "                    catalog for every render node (datasets, views, paths, session checkpoints)\n"
             "  --node-id NAME    this node in session ids (NAME.<hex>), welcome, /healthz, /metrics and\n"
             "                    the catalog's checkpoints: 1-32 of [A-Za-z0-9_-] (default: the host name so\n"
             "                    sanitized); nodes sharing one catalog need distinct ids\n"
@@ -129,7 +135,7 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    sqlite3 *db = NULL;
+    sl_db *db = NULL;
     sl_err err = {0};
     if (sl_catalog_open(cfg->db_path, &db, &err) != SL_OK) {
         fprintf(stderr, "sightline-server: %s\n", err.message);
@@ -166,6 +172,11 @@ static int run_catalog(sl_server_config *cfg, int argc, char **argv)
         }
     } else if (strcmp(cmd, "remove") == 0 && argc == 2) {
         if (sl_catalog_remove(db, argv[1], &err) != SL_OK) {
+            fprintf(stderr, "sightline-server: %s\n", err.message);
+            rc = 1;
+        }
+    } else if (strcmp(cmd, "refresh") == 0 && argc == 2) {
+        if (sl_catalog_refresh_file(db, argv[1], cfg->data_dirs, cfg->data_dir_count, &err) != SL_OK) {
             fprintf(stderr, "sightline-server: %s\n", err.message);
             rc = 1;
         }
@@ -297,7 +308,7 @@ int main(int argc, char **argv)
         snprintf(data_default, sizeof data_default, "%s", dir_exists("data") ? "data" : SL_SOURCE_DIR "/data");
         cfg.data_dirs[cfg.data_dir_count++] = data_default;
     }
-    if (cfg.db_path == db_default)
+    if (cfg.db_path == db_default) /* a URL given with --db has no parent directory to make */
         make_parent_dirs(db_default);
     if (catalog_at)
         return run_catalog(&cfg, npos, positional);

@@ -281,7 +281,8 @@ static enum scene_status ensure_scene(render_ctx *ctx, sl_session *s, const sl_s
         if (!ds) {
             sl_dataset_load *l = NULL;
             sl_dataset_origin origin = SL_DATASET_CACHED;
-            if (sl_dataset_cache_request(ctx->datasets, st->dataset_source, st->dataset_is_file, &ds, &l, &origin,
+            if (sl_dataset_cache_request(ctx->datasets, st->dataset_source, st->dataset_is_file,
+                                         st->dataset_checksum, &ds, &l, &origin,
                                          err) != SL_OK)
                 return SCENE_LOAD_FAILED;
             if (l) {

@@ -195,7 +195,7 @@ static sl_status pick_default_dataset(sl_server *srv, const sl_technique *t, sl_
             continue;
         if (!cJSON_IsString(name) ||
             sl_catalog_lookup(srv->db, name->valuestring, st->dataset_source, sizeof st->dataset_source, &is_file,
-                              &kind, err) != SL_OK)
+                              &kind, st->dataset_checksum, err) != SL_OK)
             continue;
         if (!(t->dataset_kinds & (unsigned)kind))
             continue;
@@ -526,7 +526,7 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
     sl_err err = {0};
     if (dataset && dataset[0] && strcmp(dataset, next.dataset) != 0) {
         if (sl_catalog_lookup(srv->db, dataset, next.dataset_source, sizeof next.dataset_source,
-                              &next.dataset_is_file, &next.dataset_kind, &err) != SL_OK) {
+                              &next.dataset_is_file, &next.dataset_kind, next.dataset_checksum, &err) != SL_OK) {
             send_error(srv, c, "not_found", err.message, "dataset");
             return;
         }

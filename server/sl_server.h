@@ -20,7 +20,9 @@
  *              at each new still frame and another node restores a session
  *              from after the first one died; SHA-256 of join tokens (service thread)
  *   agent.c    the HAProxy agent-check listener (--agent-port; its own thread)
- *   catalog.c  SQLite catalog (service thread and the CLI)
+ *   catalog.c  the catalog: datasets, views, paths, checkpoints (sl_catalog.h;
+ *              service thread and the CLI), its schema in catalog_schema.c,
+ *              over the data-access layer db.c + db_sqlite.c / db_pg.c (sl_db.h)
  *   http.c     /healthz and /metrics bodies (service thread)
  *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
  * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
@@ -48,7 +50,6 @@
 
 #include <pthread.h>
 #include <signal.h>
-#include <sqlite3.h>
 #include <stdatomic.h>
 #include <stdint.h>
 
@@ -57,6 +58,7 @@
 #include "core/sl_clock.h"
 #include "core/sl_params.h"
 #include "core/sl_status.h"
+#include "sl_catalog.h"
 #include "sl_protocol.h"
 
 struct lws;
@@ -72,9 +74,6 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 #define SL_CLIENT_MAX_TEXT 32          /* queued replies to the client's own requests; more closes it */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
-#define SL_CATALOG_MAX_VIEWS 256       /* saved views; save_view of a new name fails above */
-#define SL_CATALOG_MAX_PATHS 256       /* saved paths; save_path of a new name fails above */
-#define SL_CATALOG_MAX_PATH_BYTES 32768 /* JSON text of one saved path */
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
 
 typedef struct sl_server_config {
@@ -140,6 +139,7 @@ typedef struct sl_session_state {
     char dataset_source[SL_SOURCE_MAX];  /* generator JSON or absolute file path */
     int dataset_is_file;
     int dataset_kind;
+    char dataset_checksum[SL_CATALOG_CHECKSUM_SIZE]; /* files: the catalog's checksum ("" none) */
     char technique[SL_PROTO_NAME_MAX];
     sl_params params;
     sl_camera_spec camera;               /* checked on arrival (sl_msg_camera_check) */
@@ -358,7 +358,7 @@ typedef struct sl_server {
     sl_server_config cfg;
     struct lws_context *lws;
     int port;                                /* listening port (after sl_ws_create) */
-    sqlite3 *db;                             /* [service] */
+    sl_db *db;                             /* [service] */
     pthread_mutex_t lock;
     pthread_cond_t wake;                     /* render thread waits here */
     sl_session *sessions;                    /* [lock] */
@@ -456,9 +456,14 @@ void sl_dataset_cache_destroy(sl_dataset_cache *c);
  * else generator JSON): cached (*out: the caller's own reference, for
  * sl_pipeline_set_dataset or sl_dataset_destroy), or *load: a reference to
  * its load (release it with sl_dataset_load_release). *origin says which.
- * A cached file whose inode, size or mtime changed is loaded again. Fails
- * only when out of memory or for a source of SL_SOURCE_MAX bytes or more. */
-sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int is_file, sl_dataset **out,
+ * A cached file whose inode, size or mtime changed is loaded again. A file
+ * with a checksum (the catalog's, sl_catalog_file_checksum; NULL or ""
+ * for none) is read only when its bytes still have it: else the load fails
+ * naming both checksums (a node whose data directory holds another file
+ * than the one registered refuses it). Fails here only when out of memory
+ * or for a source of SL_SOURCE_MAX bytes or more. */
+sl_status sl_dataset_cache_request(sl_dataset_cache *c, const char *source, int is_file, const char *checksum,
+                                   sl_dataset **out,
                                    sl_dataset_load **load, sl_dataset_origin *origin, sl_err *err);
 /* 0 while the load is queued or running. 1 when it finished; then, when out
  * is not NULL: *status SL_OK and *out the caller's own reference, or the
@@ -502,67 +507,6 @@ int sl_record_take_download(sl_server *srv, const char *key, const char *token, 
 /* render.c */
 sl_status sl_render_start(sl_server *srv, sl_err *err);
 void sl_render_stop(sl_server *srv);
-
-/* catalog.c — every query uses bound parameters. */
-sl_status sl_catalog_open(const char *path, sqlite3 **out, sl_err *err);
-void sl_catalog_close(sqlite3 *db);
-/* At every start: registers the built-in generator datasets and the files
- * in <dir>/samples that are absent, except names that were removed. */
-sl_status sl_catalog_init_defaults(sqlite3 *db, const char *const *data_dirs, int dir_count, sl_err *err);
-/* Registers every absent built-in, removed or not (`catalog add-builtins`). */
-sl_status sl_catalog_add_builtins(sqlite3 *db, int *added, sl_err *err);
-/* Adds a file; refused when outside every data_dir (after realpath). */
-sl_status sl_catalog_add_file(sqlite3 *db, const char *path, const char *const *data_dirs, int dir_count,
-                              sl_err *err);
-sl_status sl_catalog_scan(sqlite3 *db, const char *dir, const char *const *data_dirs, int dir_count,
-                          int *added, sl_err *err);
-/* Deletes the row and records the name as removed (see init_defaults). */
-sl_status sl_catalog_remove(sqlite3 *db, const char *name, sl_err *err);
-/* Registers a named generator call (validated by generating it once). */
-sl_status sl_catalog_add_generator(sqlite3 *db, const char *name, const char *generator_json, sl_err *err);
-/* Bounds, counts and attribute names of a dataset as malloc'd JSON texts (no
- * database: callable from the render thread). */
-void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, char **attrs);
-/* Fills bounds/counts/attributes of a row that has none yet (built-ins). */
-sl_status sl_catalog_set_info(sqlite3 *db, const char *name, const char *bounds, const char *counts,
-                              const char *attrs, sl_err *err);
-/* JSON array of {name, kind, source ("file"|"generator"), generator?, bounds,
- * counts, attributes, ...}; the absolute file `path` only with with_paths
- * (the CLI; clients never see server paths). */
-cJSON *sl_catalog_list_json(sqlite3 *db, int with_paths);
-/* Fills source (generator JSON or path), is_file and kind; SL_ERR_INVALID when unknown. */
-sl_status sl_catalog_lookup(sqlite3 *db, const char *name, char *source, size_t source_size, int *is_file,
-                            int *kind, sl_err *err);
-/* Stores or replaces a named view; SL_ERR_LIMIT for a new name when
- * SL_CATALOG_MAX_VIEWS views exist. */
-sl_status sl_catalog_save_view(sqlite3 *db, const char *name, const char *dataset, const char *technique,
-                               const char *params_json, const char *camera_json, sl_err *err);
-/* *view receives {name, dataset, technique, params, camera} or NULL when absent. */
-sl_status sl_catalog_load_view(sqlite3 *db, const char *name, cJSON **view, sl_err *err);
-cJSON *sl_catalog_list_views_json(sqlite3 *db);
-/* Stores or replaces a named path (path_json already checked by the
- * caller, with its key count and last key time); SL_ERR_LIMIT when the
- * text is over SL_CATALOG_MAX_PATH_BYTES or, for a new name,
- * SL_CATALOG_MAX_PATHS paths exist. */
-sl_status sl_catalog_save_path(sqlite3 *db, const char *name, const char *technique, const char *path_json,
-                               int keys, double duration, sl_err *err);
-/* *path receives the stored path object, or NULL when no path has that name. */
-sl_status sl_catalog_load_path(sqlite3 *db, const char *name, cJSON **path, sl_err *err);
-/* [{name, technique, keys, duration, created}] by name. */
-cJSON *sl_catalog_list_paths_json(sqlite3 *db);
-/* Session checkpoints (issue 16): one row per live session of any node. state_json is the
- * sl_msg_state_json text plus whatever the server needs to restore (see session.c);
- * token_hash is the lowercase hex SHA-256 of the join token (64 chars + NUL), never the token;
- * node is the owning node id. put is an upsert that also sets `updated`. */
-sl_status sl_catalog_session_put(sqlite3 *db, const char *id, const char *node, const char *token_hash,
-                                 const char *state_json, sl_err *err);
-/* SL_OK and *state_json (malloc'd, caller frees) when found; SL_ERR_INVALID with a
- * "no checkpoint" message when not. token_hash gets 65 bytes; node gets node_size bytes. */
-sl_status sl_catalog_session_get(sqlite3 *db, const char *id, char **state_json, char token_hash[65],
-                                 char *node, size_t node_size, sl_err *err);
-sl_status sl_catalog_session_remove(sqlite3 *db, const char *id, sl_err *err);
-/* At a node's start: removes only the rows of that node (other nodes' sessions survive). */
-sl_status sl_catalog_sessions_clear_node(sqlite3 *db, const char *node, sl_err *err);
 
 /* checkpoint.c (service thread) */
 /* Lowercase hex SHA-256 of token into hex (65 bytes). SL_ERR_NOMEM when libcrypto fails. */

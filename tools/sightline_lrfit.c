@@ -5,6 +5,7 @@
  * Usage: sightline-lrfit VOLUME --out F.lr[.gz] [--degree 2] [--tol E]
  *        [--max-levels L] [--max-basis N] [--cells N] [--fraction F]
  *        [--stride S] [--max-iterations N] [--cg-iterations N] [--cg-tol T]
+ *        [--strategy structured|minimal-span]
  * VOLUME: anything sl_dataset_open accepts that is a scalar volume or vector
  * field (a file such as data/samples/ch2.nii.gz, a built-in, generator
  * JSON), or field:abc[:N] / field:tornado[:N], the analytic fields sampled
@@ -24,7 +25,7 @@ static void usage(void)
 {
     fprintf(stderr, "usage: sightline-lrfit VOLUME --out F.lr[.gz] [--degree 1..3] [--tol E] [--max-levels L]\n"
                     "       [--max-basis N] [--cells N] [--fraction F] [--stride S] [--max-iterations N]\n"
-                    "       [--cg-iterations N] [--cg-tol T]\n"
+                    "       [--cg-iterations N] [--cg-tol T] [--strategy structured|minimal-span]\n"
                     "VOLUME: a scalar volume or vector field sl_dataset_open accepts, or field:abc[:N] /\n"
                     "        field:tornado[:N] (analytic fields on N^3 voxels, default 64)\n");
 }
@@ -86,7 +87,10 @@ int main(int argc, char **argv)
         else if (strcmp(a, "--fraction") == 0) ok = parse_double(v, 1e-9, 1.0, &p.fraction);
         else if (strcmp(a, "--stride") == 0) { ok = parse_long(v, 1, 1024, &l); p.stride = (int)l; }
         else if (strcmp(a, "--max-iterations") == 0) { ok = parse_long(v, 0, 100000, &l); p.max_iterations = (int)l; }
-        else if (strcmp(a, "--cg-tol") == 0) ok = parse_double(v, 1e-300, 0.5, &p.cg_tol);
+        else if (strcmp(a, "--strategy") == 0) {
+            ok = strcmp(v, "structured") == 0 || strcmp(v, "minimal-span") == 0;
+            p.strategy = strcmp(v, "minimal-span") == 0 ? SL_LR_FIT_MINIMAL_SPAN : SL_LR_FIT_STRUCTURED;
+        } else if (strcmp(a, "--cg-tol") == 0) ok = parse_double(v, 1e-300, 0.5, &p.cg_tol);
         else if (strcmp(a, "--cg-iterations") == 0) { ok = parse_long(v, 1, 100000, &l); p.cg_iterations = (int)l; }
         else {
             fprintf(stderr, "sightline-lrfit: unknown option %s\n", a);
@@ -146,7 +150,8 @@ int main(int argc, char **argv)
     }
     const char *why = s.max_error <= p.tol  ? "tolerance reached"
                       : s.cap_hit           ? "basis-function cap reached (--max-basis)"
-                      : s.levels_exhausted  ? "max levels reached (nothing above the tolerance can be refined)"
+                      : s.levels_exhausted  ? "nothing above the tolerance can be refined (its spans are at --max-levels"
+                                              " or at two sample spacings)"
                                             : "iteration limit reached";
     printf("final: %zu elements, %zu basis functions, %d levels (level ratio %g), %zu samples, max error %.6g,"
            " mean error %.6g, %d iterations, %.2f s: %s\n", s.elements, s.basis, s.levels, sl_lr_level_ratio(&lr),

@@ -386,6 +386,9 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
     cJSON_AddNumberToObject(s, "ray_samples", last->render.samples);
     cJSON_AddNumberToObject(s, "ray_samples_skipped", last->render.samples_skipped);
     cJSON_AddNumberToObject(s, "skipped_fraction", all > 0.0 ? last->render.samples_skipped / all : 0.0);
+    /* Derived data rebuilt inside renders (lr_volume's streamlines): the first frame's, the last one's. */
+    cJSON_AddNumberToObject(s, "rebuild_ms_first", first->render.rebuild_ms);
+    cJSON_AddNumberToObject(s, "rebuild_ms_last", last->render.rebuild_ms);
     char *out = cJSON_Print(s);
     cJSON_Delete(s);
     errno = 0;

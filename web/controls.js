@@ -32,13 +32,16 @@ function fmt(v, type) {
   return s.includes('.') && !s.includes('e') ? s.replace(/0+$/, '').replace(/\.$/, '') : s;
 }
 
-// Slider position <-> value; wide ranges (max/min > 1000, min >= 0) are logarithmic.
+// Slider position <-> value; wide ranges (max/min > 1000, min >= 0) are logarithmic,
+// from min (or 1e-4 when min is 0) to max, so a tolerance of [1e-12, 1] slides over
+// every decade.
 function scaleFor(def) {
   const lo = def.min, hi = def.max;
   if (def.type === 'float' && lo >= 0 && hi > 1000 * Math.max(lo, 1e-6)) {
-    const l0 = Math.log10(Math.max(lo, 1e-4)), l1 = Math.log10(hi);
+    const floor = lo > 0 ? lo : 1e-4;
+    const l0 = Math.log10(floor), l1 = Math.log10(hi);
     return {
-      toSlider: (v) => (v <= 0 ? 0 : (Math.log10(Math.max(v, 1e-4)) - l0) / (l1 - l0)),
+      toSlider: (v) => (v <= 0 ? 0 : (Math.log10(Math.max(v, floor)) - l0) / (l1 - l0)),
       fromSlider: (s) => (s <= 0 ? lo : 10 ** (l0 + s * (l1 - l0))),
       step: 'any', min: 0, max: 1,
     };

@@ -1,11 +1,12 @@
-/* bench_timing.c — timed frames through the pipeline, cameras, peak memory, table cells (sl_bench.h).
+/* bench_timing.c — timed frames through the pipeline, cameras, peak memory, table cells,
+ * sample percentiles (sl_bench.h).
  *
  * A frame's time runs from its first GL command (sl_pipeline_render begins the
  * target) to glFinish after glReadPixels into host memory, less the prepare
  * that only the warm-up frame runs. Peak RSS is the kernel's VmHWM, reset
  * before each run through /proc/self/clear_refs ("5") where that is allowed;
  * elsewhere it is the peak since the process started (said in the table).
- * Main thread (GL).
+ * Main thread (GL); the sl_bench_stat functions run on any thread, one object per thread.
  */
 #include "sl_bench.h"
 
@@ -29,6 +30,38 @@ double sl_bench_median(double *v, int n)
         return 0.0;
     qsort(v, (size_t)n, sizeof *v, cmp_double);
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void sl_bench_stat_add(sl_bench_stat *s, double x)
+{
+    if (s->n < SL_BENCH_STAT_MAX)
+        s->v[s->n++] = x;
+    else
+        s->dropped++;
+}
+
+void sl_bench_stat_merge(sl_bench_stat *into, const sl_bench_stat *from)
+{
+    for (int i = 0; i < from->n; i++)
+        sl_bench_stat_add(into, from->v[i]);
+    into->dropped += from->dropped;
+}
+
+double sl_bench_stat_pct(sl_bench_stat *s, double p)
+{
+    if (s->n == 0)
+        return NAN;
+    qsort(s->v, (size_t)s->n, sizeof s->v[0], cmp_double);
+    int i = (int)ceil(p / 100.0 * s->n) - 1;
+    return s->v[i < 0 ? 0 : i >= s->n ? s->n - 1 : i];
+}
+
+double sl_bench_stat_mean(const sl_bench_stat *s)
+{
+    double sum = 0;
+    for (int i = 0; i < s->n; i++)
+        sum += s->v[i];
+    return s->n ? sum / s->n : NAN;
 }
 
 size_t sl_bench_segment_count(const sl_dataset *ds)

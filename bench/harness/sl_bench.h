@@ -86,6 +86,22 @@ void sl_bench_print_gpu_note(void);
 
 /* Median of n values (sorts v). */
 double sl_bench_median(double *v, int n);
+
+/* Samples of one measured quantity (latencies, open times) for percentiles.
+ * Zero-initialised = empty; keeps the first SL_BENCH_STAT_MAX samples and
+ * counts the rest in `dropped`. Not thread-safe: one per thread, then merge. */
+#define SL_BENCH_STAT_MAX 8192
+typedef struct sl_bench_stat {
+    double v[SL_BENCH_STAT_MAX];
+    int n, dropped;
+} sl_bench_stat;
+void sl_bench_stat_add(sl_bench_stat *s, double x);
+/* Appends every sample of `from` to `into` (what does not fit is counted as dropped). */
+void sl_bench_stat_merge(sl_bench_stat *into, const sl_bench_stat *from);
+/* The p-th percentile (0 < p <= 100, nearest rank; sorts the samples); NAN when empty. */
+double sl_bench_stat_pct(sl_bench_stat *s, double p);
+/* The mean; NAN when empty. */
+double sl_bench_stat_mean(const sl_bench_stat *s);
 /* Segments of a line set (pairs of consecutive vertices of each line). */
 size_t sl_bench_segment_count(const sl_dataset *ds);
 

@@ -28,18 +28,19 @@ struct sl_flow_gpu {
     sl_lr_bezier_gpu blocks;
 };
 
+const char *const sl_flow_precision_names[4] = {"single", "mixed", "double", NULL};
+
 int sl_flow_precision_find(const char *name)
 {
-    static const char *names[3] = {"single", "mixed", "double"};
     for (int i = 0; name && i < 3; i++)
-        if (strcmp(name, names[i]) == 0)
+        if (strcmp(name, sl_flow_precision_names[i]) == 0)
             return i;
     return -1;
 }
 
 const char *sl_flow_precision_name(sl_flow_precision p)
 {
-    return p == SL_FLOW_SINGLE ? "single" : p == SL_FLOW_MIXED ? "mixed" : p == SL_FLOW_DOUBLE ? "double" : "?";
+    return p >= SL_FLOW_SINGLE && p <= SL_FLOW_DOUBLE ? sl_flow_precision_names[p] : "?";
 }
 
 static int has_doubles(void)

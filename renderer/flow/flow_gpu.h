@@ -30,6 +30,8 @@
 typedef enum sl_flow_precision {
     SL_FLOW_SINGLE = 0, SL_FLOW_MIXED = 1, SL_FLOW_DOUBLE = 2
 } sl_flow_precision;
+/* "single", "mixed", "double" in sl_flow_precision order, NULL-terminated. */
+extern const char *const sl_flow_precision_names[4];
 /* "single" | "mixed" | "double"; -1 when unknown. */
 int sl_flow_precision_find(const char *name);
 const char *sl_flow_precision_name(sl_flow_precision p);

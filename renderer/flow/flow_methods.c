@@ -46,6 +46,10 @@ const sl_flow_method sl_flow_methods[SL_FLOW_SOLVER_COUNT] = {
                        {25.0 / 216.0, 0.0, 1408.0 / 2565.0, 2197.0 / 4104.0, -1.0 / 5.0, 0.0}},
 };
 
+const char *const sl_flow_solver_names[SL_FLOW_SOLVER_COUNT + 1] = {
+    "rk1", "rk2", "rk3", "rk4", "rk4_38", "rkf5", "he", "bs", "rkf45", NULL,
+};
+
 int sl_flow_solver_find(const char *name)
 {
     if (!name)

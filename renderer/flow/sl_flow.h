@@ -4,7 +4,7 @@
  *
  * Why a folder of its own: the same integrators serve regular vector
  * volumes (trilinear), LR-spline vector volumes and analytic test fields,
- * and feed sightline-trace, the benchmarks and (later) the tubes of
+ * and feed sightline-trace, the benchmarks and the streamline tubes of
  * lr_volume; none of those owns them.
  *
  * Pieces: sl_flow_field (sampling, CPU, double), the Runge-Kutta table
@@ -117,6 +117,9 @@ typedef struct sl_flow_method {
  * 3(2) (FSAL not exploited: 4 evaluations a step); rkf45 Fehlberg 4(5)
  * propagating the 5th-order solution (local extrapolation). */
 extern const sl_flow_method sl_flow_methods[SL_FLOW_SOLVER_COUNT];
+/* The solvers' names in sl_flow_solver order, NULL-terminated (for
+ * parameter schemas; each equals sl_flow_methods[i].name). */
+extern const char *const sl_flow_solver_names[SL_FLOW_SOLVER_COUNT + 1];
 /* By name (case-sensitive, "rk4-38" also accepted); -1 when unknown. */
 int sl_flow_solver_find(const char *name);
 

@@ -10,9 +10,14 @@
  * renderer/volume/ code). render: one full-screen pass of lr_volume.frag.glsl
  * (the model: README.md); the transfer function is baked into volume_dvr's
  * table and texture (re-baked only when it changes, with the per-element
- * visibility of the hulls). Every parameter but lookup and forest_blocks is
- * FRAME level. Scalar volumes, and vector volumes (dim 3) by their
- * magnitude. Render thread only.
+ * visibility of the hulls). Every parameter is FRAME level but the look-up's.
+ * Scalar volumes, and vector volumes (dim 3) by their magnitude. With
+ * `streamlines` (vector volumes) the lines traced from a seed box are drawn
+ * first as tubes (lr_volume_streamlines.c: the trace is cached and redone
+ * only when a parameter that shapes the lines changes), their depth is
+ * copied, and the rays end there and are blended over them (premultiplied,
+ * ONE, ONE_MINUS_SRC_ALPHA); without, the shader composites the background
+ * itself as before. Render thread only.
  */
 #include <math.h>
 #include <stdio.h>
@@ -25,7 +30,9 @@
 #include "../gpu/sl_gpu.h"
 #include "../lrspline/sl_lr.h"
 #include "../lrspline/sl_lr_bezier.h"
+#include "../core/sl_colormap.h"
 #include "../volume/sl_volume.h"
+#include "lr_volume_streamlines.h"
 
 /* On by default, as volume_dvr's: at equal samples it trades the rings of a
  * coarse step for fine noise (README.md "Wood-grain", bench-lr-volume). */
@@ -65,9 +72,37 @@ static const sl_param_def lr_volume_params[] = {
      "octree needs dyadic knots (refused otherwise)", SL_INVALIDATE_PREPARED},
     {"forest_blocks", SL_PARAM_INT, 0, 128, {0}, NULL, "",
      "kdforest: blocks per direction (0: the default, 32)", SL_INVALIDATE_PREPARED},
+    {"streamlines", SL_PARAM_BOOL, 0, 1, {0}, NULL, "",
+     "vector volumes: streamlines from the seed box, traced on the GPU and drawn as tubes coloured by speed, "
+     "the volume composited in front of them", SL_INVALIDATE_FRAME},
+    {"seed_min", SL_PARAM_VEC3, 0.0, 1.0, {0.1, 0.1, 0.1}, NULL, "domain",
+     "streamlines: one corner of the seed box, in fractions of the domain", SL_INVALIDATE_FRAME},
+    {"seed_max", SL_PARAM_VEC3, 0.0, 1.0, {0.9, 0.9, 0.9}, NULL, "domain",
+     "streamlines: the opposite corner of the seed box", SL_INVALIDATE_FRAME},
+    {"seed_count", SL_PARAM_INT, 1, 4096, {64}, NULL, "",
+     "streamlines: seeds in the box (Halton points, deterministic)", SL_INVALIDATE_FRAME},
+    {"solver", SL_PARAM_ENUM, 0, 0, {SL_FLOW_RK4}, sl_flow_solver_names, "",
+     "streamlines: Runge-Kutta method; he, bs and rkf45 adapt their step to flow_tol, the others take the "
+     "paper's heuristic step", SL_INVALIDATE_FRAME},
+    {"flow_step", SL_PARAM_FLOAT, 0.01, 16.0, {1.0}, NULL, "element",
+     "streamlines, fixed-step solvers: h = flow_step x the element's smallest side / 2^degree (paper Eq. 4)",
+     SL_INVALIDATE_FRAME},
+    {"flow_tol", SL_PARAM_FLOAT, 1e-12, 1.0, {1e-6}, NULL, "world",
+     "streamlines, adaptive solvers: largest error of a step (embedded pair)", SL_INVALIDATE_FRAME},
+    {"t_max", SL_PARAM_FLOAT, 1e-6, 1e6, {10.0}, NULL, "time", "streamlines: integration time per line",
+     SL_INVALIDATE_FRAME},
+    {"max_samples", SL_PARAM_INT, 2, 100000, {2000}, NULL, "", "streamlines: samples per line at most",
+     SL_INVALIDATE_FRAME},
+    {"precision", SL_PARAM_ENUM, 0, 0, {SL_FLOW_MIXED}, sl_flow_precision_names, "",
+     "streamlines: single, mixed (double update, float spline) or double (paper 5.6)", SL_INVALIDATE_FRAME},
+    {"tube_radius", SL_PARAM_FLOAT, 0.0, 0.1, {0.003}, NULL, "domain diagonal",
+     "streamlines: tube radius as a fraction of the domain's diagonal; 0 = the tubes' automatic radius "
+     "(1/300 of the lines' bounding radius)", SL_INVALIDATE_FRAME},
+    {"tube_colormap", SL_PARAM_ENUM, 0, 0, {0}, sl_colormap_names, "", "streamlines: colormap of the speed",
+     SL_INVALIDATE_FRAME},
 };
 
-enum { UNIT_TF = 1, ROWS_BINDING = 5, VISIBLE_BINDING = 4, PROXY_N = 48, MAX_STEPS = 1 << 16 };
+enum { UNIT_TF = 1, UNIT_OPAQUE_DEPTH = 2, ROWS_BINDING = 5, VISIBLE_BINDING = 4, PROXY_N = 48, MAX_STEPS = 1 << 16 };
 
 typedef struct lr_volume_state {
     const sl_lr_volume *lr;        /* borrowed from the dataset */
@@ -82,6 +117,7 @@ typedef struct lr_volume_state {
     int tf_valid;
     size_t visible_elements;
     double ref;                    /* the smallest element side (world) */
+    lrv_streamlines streamlines;   /* traced and prepared at the first frame that asks */
     size_t gpu_bytes;
     sl_prepare_stats prep;
 } lr_volume_state;
@@ -99,6 +135,7 @@ static void lr_volume_release(void *opaque)
     if (s->tf_tex) glDeleteTextures(1, &s->tf_tex);
     if (s->rows_buf) glDeleteBuffers(1, &s->rows_buf);
     if (s->visible_buf) glDeleteBuffers(1, &s->visible_buf);
+    lrv_streamlines_deinit(&s->streamlines);
     sl_lr_bezier_release(&s->blocks);
     sl_lr_bezier_free(&s->bz);
     free(s->table);
@@ -173,7 +210,6 @@ static sl_status build_proxy(lr_volume_state *s, sl_err *err)
 static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out,
                                    sl_err *err)
 {
-    (void)gpu;
     *out = NULL;
     if (ds->kind != SL_DATASET_LR || !ds->lr)
         return sl_err_set(err, SL_ERR_INVALID, "lr_volume: the dataset is not an LR-spline volume");
@@ -181,6 +217,7 @@ static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "lr_volume: out of memory");
     s->lr = ds->lr;
+    lrv_streamlines_init(&s->streamlines, gpu, ds);
     s->ref = fmin(fmin(ds->lr->min_side[0], ds->lr->min_side[1]), ds->lr->min_side[2]);
     double t_pre = sl_clock_ms();
     sl_status st = sl_lr_bezier_build(s->lr, (sl_lr_lookup_kind)sl_params_choice(params, "lookup"),
@@ -265,12 +302,16 @@ static void update_tf(lr_volume_state *s, const sl_transfer_function *tf)
 static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                                   sl_render_stats *stats, sl_err *err)
 {
-    (void)target;
     lr_volume_state *s = opaque;
     int mode = sl_params_choice(params, "mode");
     GLuint p = 0;
     sl_status st = program_for(s, mode, &p, err);
     if (st != SL_OK)
+        return st;
+    /* Streamlines first: the tubes' depth ends the rays, which blend over them. */
+    int over = sl_params_bool(params, "streamlines");
+    if (over && ((st = lrv_streamlines_update(&s->streamlines, params, &stats->rebuild_ms, err)) != SL_OK ||
+                 (st = lrv_streamlines_draw(&s->streamlines, view, params, target, stats, err)) != SL_OK))
         return st;
     update_tf(s, sl_params_transfer(params, "transfer_function"));
     if (view->height > s->rows_capacity) {
@@ -308,9 +349,18 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
                 (float)((SL_VOLUME_TF_TEXELS - 1) / (s->table->hi - s->table->lo)));
     glUniform1i(glGetUniformLocation(p, "u_tf"), UNIT_TF);
     glBindTextureUnit(UNIT_TF, s->tf_tex);
+    glUniform1i(glGetUniformLocation(p, "u_over_target"), over);
+    glUniform1i(glGetUniformLocation(p, "u_opaque_depth"), UNIT_OPAQUE_DEPTH);
+    glBindTextureUnit(UNIT_OPAQUE_DEPTH, over ? s->streamlines.depth.texture : 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ROWS_BINDING, s->rows_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VISIBLE_BINDING, s->visible_buf);
-    glDisable(GL_BLEND);
+    if (over) {
+        glEnable(GL_BLEND);
+        glBlendEquation(GL_FUNC_ADD);
+        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    } else {
+        glDisable(GL_BLEND);
+    }
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_ALWAYS);
     glDepthMask(GL_TRUE);
@@ -319,6 +369,8 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glDepthFunc(GL_GREATER);
+    glDisable(GL_BLEND);
+    glBindTextureUnit(UNIT_OPAQUE_DEPTH, 0);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint *rows = malloc((size_t)view->height * 2 * sizeof *rows);
     double taken = 0.0, skipped = 0.0;
@@ -330,7 +382,7 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
         }
         free(rows);
     }
-    stats->primitives = (double)view->width * view->height;
+    stats->primitives += (double)view->width * view->height;
     stats->samples = taken;
     stats->samples_skipped = skipped;
     stats->culled = (double)(s->bz.element_count - s->visible_elements);
@@ -346,7 +398,7 @@ static void lr_volume_prepare_stats(const void *opaque, sl_prepare_stats *out)
 static size_t lr_volume_gpu_bytes(const void *opaque)
 {
     const lr_volume_state *s = opaque;
-    return s ? s->gpu_bytes : 0;
+    return s ? s->gpu_bytes + lrv_streamlines_gpu_bytes(&s->streamlines) : 0;
 }
 
 const sl_technique sl_lr_volume_technique = {

@@ -13,9 +13,13 @@
 // from the CPU per transfer function), mip over elements whose hull maximum cannot raise
 // the running maximum. The element at a point is reused while the point stays in its box
 // (else lr_find_element). Skipping keeps the uniform lattice, so it changes no sample
-// there. With u_jitter, every segment is sampled at the pixel's offset u in [0, 1) of it
-// (sl_volume_jitter of the pixel: the same per frame) instead of its midpoint, against
-// wood-grain. Variants: LR_MODE 0 composite, 1 mip; lr_bezier.glsl's.
+// there. u_over_target 0: the background is composited here (C + (1 - A) background, opaque,
+// blending off). 1 (streamline tubes drawn before, lr_volume_streamlines.c): the ray also
+// ends at the eye distance of u_opaque_depth (their reversed-Z depth, 0 = none), the output
+// is premultiplied (C, A) for blending (ONE, ONE_MINUS_SRC_ALPHA) over the target, and the
+// depth is max(tube, volume). With u_jitter, every segment is sampled at the pixel's offset
+// u in [0, 1) of it (sl_volume_jitter of the pixel: the same per frame) instead of its
+// midpoint, against wood-grain. Variants: LR_MODE 0 composite, 1 mip; lr_bezier.glsl's.
 #include "gpu/glsl/camera.glsl"
 #include "lrspline/lr_find.glsl"
 #include "volume/volume_ray.glsl"
@@ -34,6 +38,8 @@ uniform float u_alpha_stop;
 uniform int u_shading;
 uniform int u_skipping;
 uniform int u_max_steps;       // guard against a stalled ray
+uniform int u_over_target;     // 1: blend over geometry drawn before (see the header)
+uniform sampler2D u_opaque_depth; // that geometry's reversed-Z depth (texelFetch, level 0)
 uniform int u_jitter;          // 1: sample at the pixel's offset in each segment, 0: at midpoints
 
 layout(std430, binding = 5) buffer lr_rows { uint lr_row_counts[]; };  // per row: taken, skipped
@@ -53,6 +59,12 @@ void main()
     vec3 inv_d = sl_volume_safe_inverse(d);
     vec2 tb = sl_volume_ray_box(eye, inv_d, u_lr_domain_lo, u_lr_domain_hi);
     float t0 = max(tb.x, 0.0), t1 = tb.y;
+    float opaque = 0.0;
+    if (u_over_target != 0) {
+        opaque = texelFetch(u_opaque_depth, ivec2(gl_FragCoord.xy), 0).r;
+        if (opaque > 0.0)
+            t1 = min(t1, sl_distance_of_depth(opaque, d));
+    }
     if (!(t1 > t0))
         discard;
     uint taken = 0u, skipped = 0u;
@@ -136,13 +148,14 @@ void main()
 #if LR_MODE == 0
     if (!(A > 0.0))
         discard;
-    o_color = vec4(C + (1.0 - A) * u_background, 1.0);
-    gl_FragDepth = depth_t >= 0.0 ? sl_depth_of(eye + depth_t * d) : 0.0;
+    float depth = depth_t >= 0.0 ? sl_depth_of(eye + depth_t * d) : 0.0;
+    o_color = u_over_target != 0 ? vec4(C, A) : vec4(C + (1.0 - A) * u_background, 1.0);
+    gl_FragDepth = max(opaque, depth);
 #else
     if (!any)
         discard;
     vec4 c = sl_volume_tf(vmax);
-    o_color = vec4(c.a * c.rgb + (1.0 - c.a) * u_background, 1.0);
-    gl_FragDepth = 0.0;
+    o_color = u_over_target != 0 ? vec4(c.a * c.rgb, c.a) : vec4(c.a * c.rgb + (1.0 - c.a) * u_background, 1.0);
+    gl_FragDepth = opaque;
 #endif
 }

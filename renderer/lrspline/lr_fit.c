@@ -364,6 +364,57 @@ static int rank_cmp(const void *pa, const void *pb)
     return (a->id > b->id) - (a->id < b->id);
 }
 
+/* 1 when a knot span [a, z] in direction d may still be halved. */
+static int halvable(double a, double z, const double min_span[3], int d)
+{
+    return z - a >= 2.0 * min_span[d] * (1.0 - 1e-9);
+}
+
+/* Structured: the basis functions with an error above tol in their support
+ * (the largest element error there) and a span that may be halved, into
+ * cand (unsorted); basis_err is scratch of basis_count zeros. Returns how many. */
+static size_t rank_basis(const sl_lr_volume *lr, const double *elem_err, double tol, const double min_span[3],
+                         double *basis_err, rank *cand)
+{
+    for (size_t e = 0; e < lr->element_count; e++) {
+        const sl_lr_element *x = &lr->elements[e];
+        for (uint32_t k = 0; k < x->basis_count; k++) {
+            uint32_t b = lr->element_basis[x->basis_offset + k];
+            basis_err[b] = fmax(basis_err[b], elem_err[e]);
+        }
+    }
+    size_t nc = 0;
+    for (size_t b = 0; b < lr->basis_count; b++) {
+        if (!(basis_err[b] > tol))
+            continue;
+        int refinable = 0;
+        const sl_lr_basis *bb = &lr->basis[b];
+        for (int d = 0; d < 3 && !refinable; d++)
+            for (int k = 0; k < lr->order[d] && !refinable; k++)
+                refinable = halvable(bb->knots[d][k], bb->knots[d][k + 1], min_span, d);
+        if (refinable)
+            cand[nc++] = (rank){basis_err[b], (uint32_t)b};
+    }
+    return nc;
+}
+
+/* Minimal span: the elements with an error above tol and a side that may
+ * be halved, into cand (unsorted). Returns how many. */
+static size_t rank_elements(const sl_lr_volume *lr, const double *elem_err, double tol, const double min_span[3],
+                            rank *cand)
+{
+    size_t nc = 0;
+    for (size_t e = 0; e < lr->element_count; e++) {
+        const sl_lr_element *x = &lr->elements[e];
+        int refinable = 0;
+        for (int d = 0; d < 3; d++)
+            refinable |= halvable(x->lo[d], x->hi[d], min_span, d);
+        if (elem_err[e] > tol && refinable)
+            cand[nc++] = (rank){elem_err[e], (uint32_t)e};
+    }
+    return nc;
+}
+
 typedef struct coef_ctx {
     const samples *s;
 } coef_ctx;
@@ -409,6 +460,8 @@ static sl_status check_params(const sl_dataset *ds, const sl_lr_fit_params *p, s
         return sl_err_set(err, SL_ERR_INVALID, "max levels %d is outside 0..16", p->max_levels);
     if (p->cells_longest < 1 || p->cells_longest > 1024)
         return sl_err_set(err, SL_ERR_INVALID, "initial cells %d is outside 1..1024", p->cells_longest);
+    if (p->strategy != SL_LR_FIT_STRUCTURED && p->strategy != SL_LR_FIT_MINIMAL_SPAN)
+        return sl_err_set(err, SL_ERR_INVALID, "unknown refinement strategy %d", (int)p->strategy);
     if (!(p->fraction > 0.0 && p->fraction <= 1.0))
         return sl_err_set(err, SL_ERR_INVALID, "refinement fraction %g is outside (0, 1]", p->fraction);
     if (!(p->cg_tol > 0.0 && p->cg_tol < 1.0))
@@ -556,8 +609,9 @@ knots_done:
         free(ids);
         elem_err = malloc(out->element_count * sizeof *elem_err);
         basis_err = calloc(out->basis_count, sizeof *basis_err);
-        cand = malloc(out->basis_count * sizeof *cand);
-        ids = malloc(out->basis_count * sizeof *ids);
+        size_t ranked = out->basis_count > out->element_count ? out->basis_count : out->element_count;
+        cand = malloc(ranked * sizeof *cand);
+        ids = malloc(ranked * sizeof *ids);
         if (!elem_err || !basis_err || !cand || !ids) {
             st = sl_err_set(err, SL_ERR_NOMEM, "out of memory for the error measures");
             break;
@@ -584,26 +638,8 @@ knots_done:
                     refine_seconds);
         if (mx <= p->tol || iter >= p->max_iterations)
             break;
-        /* Rank the basis functions by the largest element error in their support. */
-        for (size_t e = 0; e < out->element_count; e++) {
-            const sl_lr_element *x = &out->elements[e];
-            for (uint32_t k = 0; k < x->basis_count; k++) {
-                uint32_t b = out->element_basis[x->basis_offset + k];
-                basis_err[b] = fmax(basis_err[b], elem_err[e]);
-            }
-        }
-        size_t nc = 0;
-        for (size_t b = 0; b < out->basis_count; b++) {
-            if (!(basis_err[b] > p->tol))
-                continue;
-            int refinable = 0;
-            const sl_lr_basis *bb = &out->basis[b];
-            for (int d = 0; d < 3 && !refinable; d++)
-                for (int k = 0; k < order[d] && !refinable; k++)
-                    refinable = bb->knots[d][k + 1] - bb->knots[d][k] >= 2.0 * min_span[d] * (1.0 - 1e-9);
-            if (refinable)
-                cand[nc++] = (rank){basis_err[b], (uint32_t)b};
-        }
+        size_t nc = p->strategy == SL_LR_FIT_MINIMAL_SPAN ? rank_elements(out, elem_err, p->tol, min_span, cand)
+                                                           : rank_basis(out, elem_err, p->tol, min_span, basis_err, cand);
         if (nc == 0) {
             stats->levels_exhausted = 1;
             break;
@@ -616,7 +652,9 @@ knots_done:
         if ((st = copy_model(out, &prev, err)) != SL_OK)
             break;
         double tr = now_seconds();
-        if ((st = sl_lr_refine_basis(out, ids, take, min_span, 0, NULL, err)) != SL_OK)
+        st = p->strategy == SL_LR_FIT_MINIMAL_SPAN ? sl_lr_refine_elements(out, ids, take, min_span, 0, NULL, err)
+                                                    : sl_lr_refine_basis(out, ids, take, min_span, 0, NULL, err);
+        if (st != SL_OK)
             break;
         refine_seconds = now_seconds() - tr;
         if (out->basis_count > p->max_basis) {

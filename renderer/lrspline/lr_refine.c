@@ -799,6 +799,58 @@ sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, 
     return refine(lr, rects, n, 1, err);
 }
 
+/* The basis function on element x with the smallest support in the two
+ * directions other than d (the first one on a tie). */
+static const sl_lr_basis *smallest_across(const sl_lr_volume *lr, const sl_lr_element *x, int d)
+{
+    const sl_lr_basis *best = NULL;
+    double best_area = 0.0;
+    int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+    for (uint32_t k = 0; k < x->basis_count; k++) {
+        const sl_lr_basis *b = &lr->basis[lr->element_basis[x->basis_offset + k]];
+        double area = (b->knots[d1][lr->order[d1]] - b->knots[d1][0]) * (b->knots[d2][lr->order[d2]] - b->knots[d2][0]);
+        if (!best || area < best_area) {
+            best = b;
+            best_area = area;
+        }
+    }
+    return best;
+}
+
+sl_status sl_lr_refine_elements(sl_lr_volume *lr, const uint32_t *elements, size_t n, const double min_span[3],
+                                int check, size_t *inserted, sl_err *err)
+{
+    sl_lr_meshrect *r = NULL;
+    size_t count = 0, cap = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (elements[i] >= lr->element_count)
+            return free(r), sl_err_set(err, SL_ERR_INVALID, "element id %u out of range (%zu elements)",
+                                       elements[i], lr->element_count);
+        const sl_lr_element *x = &lr->elements[elements[i]];
+        for (int d = 0; d < 3; d++) {
+            if (min_span && x->hi[d] - x->lo[d] < 2.0 * min_span[d] * (1.0 - 1e-9))
+                continue;
+            const sl_lr_basis *b = smallest_across(lr, x, d);
+            if (!b)
+                continue;
+            if (!grow((void **)&r, &cap, count + 1, sizeof *r))
+                return free(r), nomem(err);
+            sl_lr_meshrect *m = &r[count++];
+            for (int e = 0; e < 3; e++) {
+                m->lo[e] = b->knots[e][0];
+                m->hi[e] = b->knots[e][lr->order[e]];
+            }
+            m->lo[d] = m->hi[d] = 0.5 * (x->lo[d] + x->hi[d]);
+            m->multiplicity = 1;
+        }
+    }
+    sl_status st = count ? refine(lr, r, count, check, err) : SL_OK;
+    free(r);
+    if (inserted)
+        *inserted = st == SL_OK ? count : 0;
+    return st;
+}
+
 sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3], int check,
                              size_t *inserted, sl_err *err)
 {

@@ -8,12 +8,16 @@
  * centres (samples taken every `stride` voxels), solved by CGLS with column
  * scaling (Jacobi), warm-started from the previous coefficients (refinement
  * keeps f, so the warm start is the previous fit); measure the error at the
- * samples per element; refine. Refinement is "structured" (Johannessen,
- * Kvamsdal, Dokken 2014, section 5): the basis functions whose support holds
- * an error > tol, largest first, a `fraction` of them per iteration, have
- * every knot span halved over their support (sl_lr_refine_basis), spans not
- * below the finest level h0 / 2^max_levels nor below two sample spacings
- * (finer spans are not determined by the samples). Stops at max error <= tol, when
+ * samples per element; refine, by one of the two strategies of Johannessen,
+ * Kvamsdal, Dokken 2014, section 5: "structured" (the default): the basis
+ * functions whose support holds an error > tol, largest first, a `fraction`
+ * of them per iteration, have every knot span halved over their support
+ * (sl_lr_refine_basis); "minimal span": the elements with an error > tol,
+ * largest first, a `fraction` of them, are halved in each direction by the
+ * shortest mesh rectangle that splits a basis function
+ * (sl_lr_refine_elements). Spans never go below the finest level
+ * h0 / 2^max_levels nor below two sample spacings (finer spans are not
+ * determined by the samples). Stops at max error <= tol, when
  * nothing may be refined (max levels reached), at max_basis functions (the
  * cap, reported) or after max_iterations.
  * Error behaviour: least squares reproduces splines of the space exactly (a
@@ -32,8 +36,14 @@
 #include "../data/sl_dataset.h"
 #include "sl_lr.h"
 
+typedef enum {
+    SL_LR_FIT_STRUCTURED = 0,   /* halve every span of the offending basis functions */
+    SL_LR_FIT_MINIMAL_SPAN = 1, /* halve the offending elements by minimal-span rectangles */
+} sl_lr_fit_strategy;
+
 typedef struct sl_lr_fit_params {
     int degree;          /* 1..SL_LR_MAX_ORDER-1, all three directions */
+    sl_lr_fit_strategy strategy;
     double tol;          /* >= 0, absolute, in the data's units */
     int max_levels;      /* 0..16 refinement levels below the initial mesh */
     size_t max_basis;    /* cap on basis functions (>= the initial count) */
@@ -46,7 +56,7 @@ typedef struct sl_lr_fit_params {
     FILE *log;           /* one line per iteration, or NULL */
 } sl_lr_fit_params;
 
-/* Defaults: degree 2, tol 0, 4 levels, 200000 basis, 4 cells, fraction 0.5,
+/* Defaults: degree 2, structured, tol 0, 4 levels, 200000 basis, 4 cells, fraction 0.5,
  * stride 1, 64 iterations, 200 CGLS iterations to 1e-8, no log. */
 void sl_lr_fit_defaults(sl_lr_fit_params *p);
 

@@ -45,4 +45,17 @@ sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, 
 sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, const double min_span[3], int check,
                              size_t *inserted, sl_err *err);
 
+/* "Minimal span" refinement (Johannessen et al., section 5): for each
+ * listed element and each direction d in which its side is at least
+ * 2 min_span[d], one rectangle flat in d through the element's midpoint,
+ * spanning in the other two directions the support of the basis function
+ * on that element whose support there is smallest (the shortest mesh
+ * rectangle that splits at least one basis function: that one). Inserted as
+ * sl_lr_refine does; *inserted and check as for sl_lr_refine_basis.
+ * Refines less per step than the structured strategy (one rectangle per
+ * direction and element instead of one per knot span of every function),
+ * so it reaches a tolerance with fewer basis functions on local features. */
+sl_status sl_lr_refine_elements(sl_lr_volume *lr, const uint32_t *elements, size_t n, const double min_span[3],
+                                int check, size_t *inserted, sl_err *err);
+
 #endif

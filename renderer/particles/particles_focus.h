@@ -22,6 +22,7 @@
 #include "../core/sl_camera.h"
 #include "../core/sl_params.h"
 #include "../core/sl_technique.h"
+#include "../gpu/sl_depth_copy.h"
 #include "../gpu/sl_gpu.h"
 #include "../volume/sl_volume.h"
 
@@ -32,10 +33,7 @@ typedef struct pt_focus {
     int ready;                    /* bricks and marcher built (first focus frame) */
     sl_volume_bricks bricks;
     sl_volume_marcher marcher;
-    GLuint fbo, depth;            /* the depth copy, target sized: DEPTH_COMPONENT32F
-                                     (single-sample) or R32F (MSAA resolve) */
-    int width, height, msaa;      /* what fbo/depth were made for */
-    GLuint resolve_program, vao;  /* MSAA only, made at the first MSAA focus frame */
+    sl_depth_copy depth;          /* the marks' depth, target sized (first focus frame) */
 } pt_focus;
 
 /* Remembers what the marcher will read; no GL, cannot fail. */

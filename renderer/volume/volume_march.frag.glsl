@@ -47,10 +47,9 @@ void main()
     vec2 ts = sl_march_ray_sphere(u_focus.xyz, d, u_focus.w);
     t0 = max(t0, ts.x);
     t1 = min(t1, ts.y);
-    // Reversed-Z: depth = near / (distance along F) and that distance is t dot(d, F).
     float mark = texelFetch(u_opaque_depth, ivec2(gl_FragCoord.xy), 0).r;
     if (mark > 0.0)
-        t1 = min(t1, sl_near.x / (mark * dot(d, sl_forward.xyz)));
+        t1 = min(t1, sl_distance_of_depth(mark, d));
 #endif
     if (!(t1 > t0))
         discard;

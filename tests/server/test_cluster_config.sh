@@ -4,8 +4,9 @@
 # generates from docker/haproxy.cfg.template for docker/compose.yaml's nodes, and
 # HAProxy must accept both that file and the loopback layout scripts/cluster starts.
 # Each compose node must run with the node id and agent port HAProxy expects, and
-# open the one shared catalog. Containers cannot run here; this
-# checks the files, not a running cluster (tests/server/test_server_cluster.c does that).
+# open the one shared PostgreSQL catalog of the compose `postgres` service.
+# Containers cannot run here; this checks the files, not a running cluster
+# (tests/server/test_server_cluster.c does that).
 # Prints "N passed, N failed".
 set -uo pipefail
 root="${SIGHTLINE_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
@@ -24,9 +25,14 @@ for n in $nodes; do
   check 'grep -q "hostname: $n\$" <<<"$block"' "$n has hostname $n"
   agent="$(grep -o '"--agent-port", "[0-9]*"' <<<"$block" | grep -o '[0-9]*')"
   check '[ -n "$agent" ]' "$n has an --agent-port"
-  check 'grep -q "\"--db\", \"/var/lib/sightline/catalog.db\"" <<<"$block"' "$n uses the shared catalog"
+  check 'grep -q "\"--db\", \"postgresql://sightline@postgres:5432/sightline\"" <<<"$block"' "$n uses the shared PostgreSQL catalog"
   specs+=(--node "$n=$n:8080=${agent:-0}")
 done
+
+# The catalog service, and no password written into the file.
+check 'grep -qE "^  postgres:\$" "$compose"' "compose.yaml has the postgres service the nodes name"
+check 'grep -q "PGPASSWORD: \${SIGHTLINE_DB_PASSWORD:?" "$compose"' "the nodes' password comes from SIGHTLINE_DB_PASSWORD"
+check '! grep -qE "postgresql://[^@\"]*:[^@\"]*@" "$compose"' "no password inside a --db URL"
 
 # 2. docker/haproxy.cfg is the generated file, byte for byte.
 "$root/scripts/cluster" --print-haproxy-config --bind '*' --port 8080 "${specs[@]}" >"$tmp/compose.cfg"

@@ -1,17 +1,22 @@
-/* test_server_bad_file.c — a corrupt dataset file opened through the server.
+/* test_server_bad_file.c — a dataset file that changed behind the catalog's
+ * back, opened through the server.
  *
  * A small OBJ line file is written into the test's data directory and
- * registered (`catalog add` loads it, so it is valid then). Session B shows
- * it; session A shows the generated "tiny". Then the file is truncated in
- * the middle of a vertex line and A switches to it. Checks: A gets `error`
- * load_failed (field dataset) whose message names the file and carries the
- * OBJ loader's reason, and never the server's path; A's state goes back to
+ * registered (`catalog add` loads it and records its checksum). Session B
+ * shows it; session A shows the generated "tiny". Then the file is truncated
+ * in the middle of a vertex line and A switches to it. Checks: A gets `error`
+ * load_failed (field dataset) whose message names the file and says it is not
+ * the file the catalog registered (the node refuses it before parsing, as a
+ * node whose data directory differs from the others' must), and never the
+ * server's path; A's state goes back to
  * "tiny" with its technique (a state patch) and its bounds; A's next still
  * frame at the old camera is the image it showed before (mean abs
  * difference < 1), and a camera change still renders with no further error;
  * B receives no error, keeps its dataset (its loaded copy; the file is not
  * reread while B's dataset does not change) and renders on a camera change;
- * /metrics counts one load failure. Exit status 0 required.
+ * /metrics counts one load failure. Then a valid new content is written and
+ * recorded with `catalog refresh`, and A switches to it without an error
+ * (the new file's two lines, not B's cached copy). Exit status 0 required.
  */
 #include <math.h>
 
@@ -23,6 +28,7 @@
 #define H 72
 #define T 20000
 #define GOOD_OBJ "v 0 0 0\nv 1 2 3\nv 0.5 1 0\nv 1 0 3\nl 1 2\nl 3 4\n"
+#define CHANGED_OBJ "v 0 0 0\nv 2 2 3\nv 0.5 1 0\nl 1 2 3\n"
 #define TRUNCATED_OBJ "v 0 0 0\nv 1 2 3\nv 0.5 1 0\nv 1 0"
 
 static int write_file(const char *path, const char *text)
@@ -147,8 +153,8 @@ int main(void)
     SL_CHECK_MSG(cJSON_IsString(code) && strcmp(code->valuestring, "load_failed") == 0, "error code %s",
                  cJSON_IsString(code) ? code->valuestring : "(none)");
     SL_CHECK(cJSON_IsString(field) && strcmp(field->valuestring, "dataset") == 0);
-    SL_CHECK_MSG(text && strstr(text, "lines.obj") && strstr(text, "'v' has 2 of 3 coordinates"),
-                 "the message names the file and the loader's reason: %s", text ? text : "(none)");
+    SL_CHECK_MSG(text && strstr(text, "lines.obj") && strstr(text, "not the one the catalog registered"),
+                 "the message names the file and the reason: %s", text ? text : "(none)");
     SL_CHECK_MSG(text && !strstr(text, h.dir), "the message shows the server's path: %s", text ? text : "(none)");
     cJSON_Delete(err_msg);
     printf("state patches: switch to lines.obj seen separately: %d; back to tiny at version %u\n", saw_switch, v_revert);
@@ -186,6 +192,17 @@ int main(void)
     }
     SL_CHECK_MSG(b_frame && b_errors == 0 && !b_switched && !b.closed, "B: frame %d, errors %d, dataset changed %d",
                  b_frame, b_errors, b_switched);
+    SL_CHECK(harness_metric(h.port, "sightline_dataset_load_failures_total") == 1);
+
+    /* A deliberate change, recorded with `catalog refresh`, loads again. */
+    SL_CHECK(write_file(obj, CHANGED_OBJ) == 0);
+    char *refresh[] = {h.exe, "catalog", "refresh", "lines.obj", "--db", h.db, "--data-dir", data, NULL};
+    SL_CHECK(harness_run_wait(refresh) == 0);
+    SL_CHECK(tclient_send(&a, "{\"type\":\"scene\",\"dataset\":\"lines.obj\"}") == 0);
+    a_errors = 0;
+    uint32_t va = wait_dataset_patch(&a, "lines.obj", &a_errors);
+    SL_CHECK(va > 0 && wait_still_version(&a, va, &a_errors) == 0);
+    SL_CHECK_MSG(a_errors == 0, "A got %d errors opening the refreshed file", a_errors);
     SL_CHECK(harness_metric(h.port, "sightline_dataset_load_failures_total") == 1);
 
     sl_image_deinit(&before);

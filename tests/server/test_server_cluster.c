@@ -1,7 +1,9 @@
-/* test_server_cluster.c — three render nodes behind HAProxy on one shared catalog
- * (a SQLite file; PostgreSQL is the next step), all started by this test through
- * scripts/cluster, loopback only.
+/* test_server_cluster.c — three render nodes behind HAProxy on one shared
+ * PostgreSQL catalog, all started by this test through scripts/cluster (which
+ * starts a throwaway PostgreSQL with scripts/pg-temp), loopback only.
  *
+ *  0. the catalog is PostgreSQL, and the dataset registered there through one
+ *     CLI call is what every node serves;
  *  1. 30 new sessions through the balancer spread over all three nodes (each
  *     gets at least 5), and every session id starts with the node that says
  *     `welcome.node`;
@@ -22,7 +24,7 @@
  */
 #include <sys/types.h>
 
-#include "sl_server_harness.h"
+#include "sl_cluster.h"
 
 #define NODES 3
 #define NEW_SESSIONS 30
@@ -39,60 +41,6 @@ static int failures;
         }                                                                  \
     } while (0)
 
-typedef struct cluster {
-    char dir[64];           /* /tmp/sl-cluster-test-XXXXXX */
-    char db[256];           /* the shared catalog file */
-    pid_t script;           /* scripts/cluster */
-    FILE *out;              /* its stdout */
-    int port;               /* HAProxy */
-    pid_t node_pid[NODES];
-    int node_port[NODES];
-} cluster;
-
-static const char *src_dir(void)
-{
-    const char *s = getenv("SIGHTLINE_SOURCE_DIR");
-    return s ? s : ".";
-}
-
-static const char *bin_dir(void)
-{
-    const char *b = getenv("SIGHTLINE_BINARY_DIR");
-    return b ? b : "build";
-}
-
-/* A free loopback TCP port (bound, read, closed). */
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET};
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    socklen_t len = sizeof a;
-    int port = -1;
-    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 && getsockname(fd, (struct sockaddr *)&a, &len) == 0)
-        port = ntohs(a.sin_port);
-    if (fd >= 0)
-        close(fd);
-    return port;
-}
-
-/* Runs a shell command line and keeps the first line of its stdout. */
-static int run_capture(const char *cmd, char *out, size_t size)
-{
-    FILE *p = popen(cmd, "r");
-    if (!p)
-        return -1;
-    out[0] = 0;
-    if (!fgets(out, (int)size, p))
-        out[0] = 0;
-    char sink[256];
-    while (fgets(sink, sizeof sink, p))
-        ;
-    int st = pclose(p);
-    out[strcspn(out, "\n")] = 0;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 /* 1 while pid runs (a zombie child of the cluster script counts as gone). */
 static int process_alive(pid_t pid)
 {
@@ -108,122 +56,17 @@ static int process_alive(pid_t pid)
     return paren && paren[1] == ' ' && paren[2] != 'Z' && paren[2] != 'X';
 }
 
-static int cluster_start(cluster *c)
+/* The nodes the cluster's test runs, and the options that let 30 sessions and
+ * their collaborators in from one address (the balancer's). */
+static int cluster_start(sl_cluster *c)
 {
-    memset(c, 0, sizeof *c);
-    c->script = -1;
-    snprintf(c->dir, sizeof c->dir, "/tmp/sl-cluster-test-XXXXXX");
-    if (!mkdtemp(c->dir))
+    const char *args[] = {"--default-dataset", "tiny", "--max-pending", "64", "--max-clients", "128",
+                          "--max-sessions", "64", "--grace", "20", NULL};
+    if (sl_cluster_start(c, NODES, args) != 0)
         return -1;
-    char cmd[1024];
-    snprintf(c->db, sizeof c->db, "%s/catalog.db", c->dir);
-    char sink[256];
-    snprintf(cmd, sizeof cmd, "'%s/bin/sightline-server' --db '%s' catalog add-generator tiny '%s' 2>&1", bin_dir(),
-             c->db, HARNESS_TINY);
-    if (run_capture(cmd, sink, sizeof sink) != 0) {
-        fprintf(stderr, "cluster: could not register the dataset: %s\n", sink);
-        return -1;
-    }
-    c->port = free_port();
-    int base = free_port();
-    if (c->port <= 0 || base <= 0 || base > 60000)
-        return -1;
-    base = base - base % 100; /* node ports base+i, agents base+100+i */
-    int fds[2];
-    if (pipe(fds) != 0)
-        return -1;
-    c->script = fork();
-    if (c->script == 0) {
-        dup2(fds[1], 1);
-        close(fds[0]);
-        close(fds[1]);
-        setpgid(0, 0);
-        char script[512], build[512], portv[16], basev[16];
-        snprintf(script, sizeof script, "%s/scripts/cluster", src_dir());
-        snprintf(build, sizeof build, "%s", bin_dir());
-        snprintf(portv, sizeof portv, "%d", c->port);
-        snprintf(basev, sizeof basev, "%d", base);
-        char *argv[] = {"bash", script, "--nodes", "3", "--port", portv, "--base-port", basev, "--db", c->db,
-                        "--build", build, "--data-dir", c->dir, "--", "--default-dataset", "tiny",
-                        "--max-pending", "64", "--max-clients", "128", "--max-sessions", "64", "--grace", "20",
-                        NULL};
-        execvp("bash", argv);
-        _exit(127);
-    }
-    close(fds[1]);
-    c->out = fdopen(fds[0], "r");
-    if (c->script < 0 || !c->out)
-        return -1;
-    setvbuf(c->out, NULL, _IONBF, 0); /* poll() sees the descriptor, so no lines may wait in a stdio buffer */
-    /* Read the script's lines until "cluster: open" (bounded: the script waits for each node). */
-    char line[512];
-    int nodes_seen = 0;
-    double deadline = sl_clock_ms() + 120000;
-    while (sl_clock_ms() < deadline) {
-        struct pollfd pfd = {.fd = fds[0], .events = POLLIN};
-        if (poll(&pfd, 1, 500) <= 0)
-            continue;
-        if (!fgets(line, sizeof line, c->out))
-            break;
-        fputs(line, stderr);
-        int i, pid, port, agent;
-        if (sscanf(line, "cluster: node%d pid %d port %d agent %d", &i, &pid, &port, &agent) == 4 && i >= 1 &&
-            i <= NODES) {
-            c->node_pid[i - 1] = pid;
-            c->node_port[i - 1] = port;
-            nodes_seen++;
-        }
-        if (strncmp(line, "cluster: open", 13) == 0)
-            return nodes_seen == NODES ? 0 : -1;
-    }
-    fprintf(stderr, "cluster: scripts/cluster did not come up\n");
-    return -1;
-}
-
-static void cluster_stop(cluster *c)
-{
-    if (c->script > 0) {
-        kill(c->script, SIGTERM);
-        double deadline = sl_clock_ms() + 30000;
-        int status = 0;
-        while (waitpid(c->script, &status, WNOHANG) == 0 && sl_clock_ms() < deadline)
-            usleep(100000);
-        if (waitpid(c->script, &status, WNOHANG) == 0) {
-            kill(-c->script, SIGKILL);
-            waitpid(c->script, &status, 0);
-        }
-    }
-    if (c->out)
-        fclose(c->out);
-    char cmd[512];
-    if (strncmp(c->dir, "/tmp/sl-cluster-test-", 21) == 0) {
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->dir);
-        if (system(cmd) != 0)
-            fprintf(stderr, "cluster: could not remove %s\n", c->dir);
-    }
-}
-
-/* A client through `port` with /ws?session=ID when it joins, as the page connects. */
-static int connect_as_page(tclient *t, int port, const char *session)
-{
-    memset(t, 0, sizeof *t);
-    char path[160] = "/ws";
-    if (session)
-        snprintf(path, sizeof path, "/ws?session=%s", session);
-    return sl_wsclient_connect("127.0.0.1", port, path, SL_PROTO_SUBPROTOCOL, NULL, 10000, &t->ws, &t->err) == SL_OK
-               ? 0 : -1;
-}
-
-static const char *welcome_node(const tclient *t)
-{
-    const cJSON *n = cJSON_GetObjectItemCaseSensitive(t->welcome, "node");
-    return cJSON_IsString(n) ? n->valuestring : "";
-}
-
-static int node_index(const char *node)
-{
-    int i = 0;
-    return sscanf(node, "node%d", &i) == 1 && i >= 1 && i <= NODES ? i - 1 : -1;
+    /* The sessions' dataset, registered once in the shared catalog by the CLI
+     * (the nodes look the default dataset up at each hello). */
+    return sl_cluster_add_generator(c, "tiny", HARNESS_TINY);
 }
 
 static double welcome_azimuth(const tclient *t)
@@ -245,7 +88,7 @@ static const char *hello_error(int port, const char *session, const char *token,
 {
     tclient t;
     code[0] = 0;
-    if (connect_as_page(&t, port, session) != 0)
+    if (tclient_connect_page(&t, port, session) != 0)
         return NULL;
     tclient_send(&t, "{\"type\":\"hello\",\"version\":1,\"session\":\"%s\",\"token\":\"%s\",\"width\":%d,\"height\":%d}",
                  session, token, SIZE, SIZE);
@@ -271,12 +114,14 @@ int main(void)
 {
     harness_small_asan_quarantine();
     signal(SIGPIPE, SIG_IGN);
-    cluster cl;
+    sl_cluster cl;
     if (cluster_start(&cl) != 0) {
-        cluster_stop(&cl);
+        sl_cluster_stop(&cl);
         fprintf(stderr, "FAIL: the cluster did not start\n");
         return 1;
     }
+    /* 0. The nodes share one PostgreSQL catalog. */
+    CHECK(strncmp(cl.db, "postgresql://", 13) == 0, "the cluster's catalog is %s, not PostgreSQL", cl.db);
 
     /* 1. New sessions spread over the nodes. */
     static tclient s[NEW_SESSIONS];
@@ -287,15 +132,15 @@ int main(void)
         owner[i] = -1;
         seq[i] = 0;
         az_now[i] = NAN;
-        if (connect_as_page(&s[i], cl.port, NULL) != 0 || tclient_hello(&s[i], NULL, NULL, SIZE, SIZE) != 0) {
+        if (tclient_connect_page(&s[i], cl.port, NULL) != 0 || tclient_hello(&s[i], NULL, NULL, SIZE, SIZE) != 0) {
             CHECK(0, "session %d: no welcome through the balancer (%s)", i, s[i].err.message);
             continue;
         }
         s[i].auto_ack = 1;
-        owner[i] = node_index(welcome_node(&s[i]));
+        owner[i] = sl_cluster_node_index(&cl, tclient_welcome_node(&s[i]));
         char prefix[48];
-        snprintf(prefix, sizeof prefix, "%s.", welcome_node(&s[i]));
-        CHECK(owner[i] >= 0, "session %d: welcome.node '%s' is not one of the cluster's", i, welcome_node(&s[i]));
+        snprintf(prefix, sizeof prefix, "%s.", tclient_welcome_node(&s[i]));
+        CHECK(owner[i] >= 0, "session %d: welcome.node '%s' is not one of the cluster's", i, tclient_welcome_node(&s[i]));
         CHECK(strncmp(s[i].session, prefix, strlen(prefix)) == 0, "session id %s does not start with %s", s[i].session,
               prefix);
         if (owner[i] >= 0)
@@ -319,14 +164,14 @@ int main(void)
                 continue;
             joined++;
             tclient b;
-            if (connect_as_page(&b, cl.port, s[i].session) != 0 || tclient_hello(&b, s[i].session, s[i].token, SIZE, SIZE)) {
+            if (tclient_connect_page(&b, cl.port, s[i].session) != 0 || tclient_hello(&b, s[i].session, s[i].token, SIZE, SIZE)) {
                 CHECK(0, "collaborator of %s: no welcome", s[i].session);
                 tclient_close(&b);
                 continue;
             }
             b.auto_ack = 1;
-            CHECK(strcmp(welcome_node(&b), welcome_node(&s[i])) == 0, "collaborator of %s landed on %s", s[i].session,
-                  welcome_node(&b));
+            CHECK(strcmp(tclient_welcome_node(&b), tclient_welcome_node(&s[i])) == 0, "collaborator of %s landed on %s", s[i].session,
+                  tclient_welcome_node(&b));
             send_orbit(&s[i], ++seq[i], az_now[i] = 11.0 + 7.0 * i);
             int ok_a = tclient_wait_frame(&s[i], seq[i], 1, 30000) == 0;
             int ok_b = tclient_wait_frame(&b, seq[i], 1, 30000) == 0;
@@ -415,10 +260,10 @@ int main(void)
         int back = 0;
         while (!back && sl_clock_ms() - kill_ms < 15000) {
             tclient t;
-            if (connect_as_page(&t, cl.port, session) == 0 && tclient_hello(&t, session, token, SIZE, SIZE) == 0) {
+            if (tclient_connect_page(&t, cl.port, session) == 0 && tclient_hello(&t, session, token, SIZE, SIZE) == 0) {
                 t.auto_ack = 1;
-                CHECK(node_index(welcome_node(&t)) != dead && node_index(welcome_node(&t)) >= 0,
-                      "%s came back on '%s'", session, welcome_node(&t));
+                CHECK(sl_cluster_node_index(&cl, tclient_welcome_node(&t)) != dead && sl_cluster_node_index(&cl, tclient_welcome_node(&t)) >= 0,
+                      "%s came back on '%s'", session, tclient_welcome_node(&t));
                 double az = welcome_azimuth(&t);
                 CHECK(fabs(az - expect) < 1e-6, "%s came back with azimuth %g, not %g", session, az, expect);
                 CHECK(strcmp(t.session, session) == 0, "%s came back as %s", session, t.session);
@@ -428,7 +273,7 @@ int main(void)
                     worst_ms = ms > worst_ms ? ms : worst_ms;
                     restored++;
                 }
-                owner[i] = node_index(welcome_node(&t));
+                owner[i] = sl_cluster_node_index(&cl, tclient_welcome_node(&t));
                 s[i] = t; /* keep it connected: it is a session of a live node now */
                 snprintf(s[i].session, sizeof s[i].session, "%s", session);
                 snprintf(s[i].token, sizeof s[i].token, "%s", token);
@@ -457,9 +302,9 @@ int main(void)
     int on_drain = 0, opened = 0;
     tclient fresh[6];
     for (int i = 0; i < 6; i++) {
-        if (connect_as_page(&fresh[i], cl.port, NULL) == 0 && tclient_hello(&fresh[i], NULL, NULL, SIZE, SIZE) == 0) {
+        if (tclient_connect_page(&fresh[i], cl.port, NULL) == 0 && tclient_hello(&fresh[i], NULL, NULL, SIZE, SIZE) == 0) {
             opened++;
-            on_drain += node_index(welcome_node(&fresh[i])) == drain;
+            on_drain += sl_cluster_node_index(&cl, tclient_welcome_node(&fresh[i])) == drain;
         }
     }
     CHECK(opened == 6 && on_drain == 0, "while node3 drains: %d of 6 new sessions opened, %d on node3", opened, on_drain);
@@ -486,7 +331,7 @@ int main(void)
     for (int i = 0; i < NEW_SESSIONS; i++)
         if (s[i].ws)
             tclient_close(&s[i]);
-    cluster_stop(&cl);
+    sl_cluster_stop(&cl);
     if (failures)
         fprintf(stderr, "%d check(s) failed\n", failures);
     else

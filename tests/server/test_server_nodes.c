@@ -43,21 +43,6 @@ static int error_code_is(cJSON *j, const char *code)
     return ok;
 }
 
-/* A TCP port that was free a moment ago (for --agent-port). */
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = 0};
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    socklen_t len = sizeof a;
-    int port = -1;
-    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 && getsockname(fd, (struct sockaddr *)&a, &len) == 0)
-        port = ntohs(a.sin_port);
-    if (fd >= 0)
-        close(fd);
-    return port;
-}
-
 /* The agent-check line of 127.0.0.1:port into out; 0, or -1 (5 s at most). */
 static int agent_line(int port, char *out, size_t size)
 {
@@ -179,13 +164,13 @@ int main(void)
     memset(&b, 0, sizeof b);
     memset(&c, 0, sizeof c);
     b.pid = c.pid = -1;
-    int agent_port = free_port();
+    int agent_port = harness_free_port();
     char agent_arg[16];
     snprintf(agent_arg, sizeof agent_arg, "%d", agent_port);
     const char *args_a[] = {"--node-id", "node-A", "--agent-port", agent_arg, "--max-sessions", "4", NULL};
     HARNESS_START_OR_END(a, args_a);
     const char *args_b[] = {"--node-id", "node-B", NULL};
-    int agent_port_c = free_port();
+    int agent_port_c = harness_free_port();
     char agent_arg_c[16];
     snprintf(agent_arg_c, sizeof agent_arg_c, "%d", agent_port_c);
     const char *args_c[] = {"--node-id", "node-C", "--grace", "20", "--agent-port", agent_arg_c, NULL};

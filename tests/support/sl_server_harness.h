@@ -12,7 +12,9 @@
  * let a test kill a node or watch it drain. tclient wraps sl_wsclient: it
  * parses text messages into cJSON, records every binary frame (header +
  * payload copy) and acks frames when auto_ack is set. harness_cli_render
- * renders a reference with sightline-render. Loopback only.
+ * renders a reference with sightline-render. tclient_connect_page connects
+ * as the page does (/ws?session=ID, which a balancer routes by); a cluster
+ * of nodes behind HAProxy is sl_cluster.h. Loopback only.
  * One thread per tclient; header-only (static functions) for tests and bench.
  */
 #ifndef SL_SERVER_HARNESS_H
@@ -170,6 +172,22 @@ static __attribute__((unused)) int harness_start_shared(harness *h, const harnes
     return -1;
 }
 
+/* A loopback TCP port that was free a moment ago (bound, read, closed; a
+ * race only with other binders), or -1. */
+static __attribute__((unused)) int harness_free_port(void)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = 0};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    socklen_t len = sizeof a;
+    int port = -1;
+    if (fd >= 0 && bind(fd, (struct sockaddr *)&a, sizeof a) == 0 && getsockname(fd, (struct sockaddr *)&a, &len) == 0)
+        port = ntohs(a.sin_port);
+    if (fd >= 0)
+        close(fd);
+    return port;
+}
+
 static __attribute__((unused)) int harness_start(harness *h, const char *const *extra)
 {
     return harness_start_shared(h, NULL, extra);
@@ -313,6 +331,18 @@ static __attribute__((unused)) int tclient_connect(tclient *c, int port, const c
 {
     memset(c, 0, sizeof *c);
     return sl_wsclient_connect("127.0.0.1", port, "/ws", SL_PROTO_SUBPROTOCOL, origin, 10000, &c->ws, &c->err) == SL_OK
+               ? 0 : -1;
+}
+
+/* Connects through `port` as the page does: /ws, or /ws?session=ID when it
+ * joins or rejoins (a balancer routes by that query). 0, or -1 (c->err). */
+static __attribute__((unused)) int tclient_connect_page(tclient *c, int port, const char *session)
+{
+    memset(c, 0, sizeof *c);
+    char path[160] = "/ws";
+    if (session)
+        snprintf(path, sizeof path, "/ws?session=%s", session);
+    return sl_wsclient_connect("127.0.0.1", port, path, SL_PROTO_SUBPROTOCOL, NULL, 10000, &c->ws, &c->err) == SL_OK
                ? 0 : -1;
 }
 
@@ -673,6 +703,13 @@ static __attribute__((unused)) int tclient_hello(tclient *c, const char *session
     c->client_id = cJSON_IsNumber(id) ? id->valueint : 0;
     c->welcome = wel;
     return 0;
+}
+
+/* welcome.node of a welcomed client: the node serving it ("" when absent). */
+static __attribute__((unused)) const char *tclient_welcome_node(const tclient *c)
+{
+    const cJSON *n = cJSON_GetObjectItemCaseSensitive(c->welcome, "node");
+    return cJSON_IsString(n) ? n->valuestring : "";
 }
 
 #endif

@@ -400,9 +400,19 @@ static void test_step_root(void)
     SL_CHECK(sl_flow_step_root(1e-10, 5) > 0 && sl_flow_step_root(32.0, 5) == 2.0 && sl_flow_step_root(0.25, 2) == 0.5);
 }
 
+/* The schema names are the table's, in order, and find takes each back. */
+static void test_names(void)
+{
+    for (int i = 0; i < SL_FLOW_SOLVER_COUNT; i++)
+        SL_CHECK(sl_flow_solver_names[i] && strcmp(sl_flow_solver_names[i], sl_flow_methods[i].name) == 0 &&
+                 sl_flow_solver_find(sl_flow_solver_names[i]) == i);
+    SL_CHECK(sl_flow_solver_names[SL_FLOW_SOLVER_COUNT] == NULL);
+}
+
 int main(void)
 {
     test_step_root();
+    test_names();
     test_orders();
     test_adaptive();
     test_boundary_and_degenerate();

@@ -137,6 +137,24 @@ static void test_sphere(void)
     printf("sphere: %zu elements, %zu basis, %d levels, max error %.3g (tol %g)%s%s\n", s.elements, s.basis,
            s.levels, s.max_error, p.tol, s.cap_hit ? ", cap hit" : "", s.levels_exhausted ? ", levels used up" : "");
     sl_lr_free(&lr);
+    /* Minimal span refines only the offending elements, so it needs fewer
+     * basis functions for an error as small, on this local feature. */
+    size_t structured_basis = s.basis;
+    double structured_error = s.max_error;
+    p.strategy = SL_LR_FIT_MINIMAL_SPAN;
+    SL_CHECK_MSG(sl_lr_fit(ds, &p, &lr, &s, &err) == SL_OK, "%s", err.message);
+    SL_CHECK_MSG(s.max_error <= p.tol || s.cap_hit || s.levels_exhausted, "minimal span: max error %g above tol %g",
+                 s.max_error, p.tol);
+    SL_CHECK_MSG(s.basis < structured_basis && s.max_error <= fmax(p.tol, 1.5 * structured_error),
+                 "minimal span: %zu basis functions, max error %g; structured: %zu, %g", s.basis, s.max_error,
+                 structured_basis, structured_error);
+    SL_CHECK(sl_lr_finish(&lr, &err) == SL_OK);
+    again = recompute_error(ds, &lr);
+    SL_CHECK_MSG(fabs(again - s.max_error) <= 1e-9, "minimal span: reported %g, recomputed %g", s.max_error, again);
+    printf("sphere, minimal span: %zu elements, %zu basis, %d levels, max error %.3g%s\n", s.elements, s.basis,
+           s.levels, s.max_error, s.levels_exhausted ? ", levels used up" : "");
+    sl_lr_free(&lr);
+    p.strategy = SL_LR_FIT_STRUCTURED;
     /* A small cap is reported, and the model kept within it. */
     p.max_basis = 400;
     SL_CHECK(sl_lr_fit(ds, &p, &lr, &s, &err) == SL_OK);
@@ -191,6 +209,9 @@ static void test_refusals(void)
     sl_dataset *lines = sl_dataset_create(SL_DATASET_LINES, "lines");
     sl_lr_fit_defaults(&p);
     SL_CHECK(sl_lr_fit(lines, &p, &lr, &s, &err) == SL_ERR_INVALID);
+    sl_lr_fit_defaults(&p);
+    p.strategy = (sl_lr_fit_strategy)7;
+    SL_CHECK(sl_lr_fit(ds, &p, &lr, &s, &err) == SL_ERR_INVALID);
     sl_dataset_destroy(lines);
     sl_dataset_destroy(ds);
 }

@@ -180,10 +180,13 @@ static void test_local(const int order[3], int dim)
     sample(&lr, &pr, 1, &diff);
     sl_err err = {0};
     int rect_growth = 0;
-    for (int round = 0; round < 6; round++) {
+    /* Rounds cycle through random rectangles, structured refinement of
+     * random basis functions and minimal-span refinement of random elements. */
+    for (int round = 0; round < 9; round++) {
         size_t before = lr.basis_count;
         sl_status st;
-        if (round % 2 == 0) {
+        int kind = round % 3;
+        if (kind == 0) {
             sl_lr_meshrect r[3];
             for (int q = 0; q < 3; q++) {
                 int d = (q + round) % 3;
@@ -198,22 +201,32 @@ static void test_local(const int order[3], int dim)
                 r[q].multiplicity = 1;
             }
             st = sl_lr_refine(&lr, r, 3, &err);
-        } else {
+        } else if (kind == 1) {
             uint32_t ids[4];
             for (int q = 0; q < 4; q++)
                 ids[q] = (uint32_t)(urand() * (double)lr.basis_count);
-            st = sl_lr_refine_basis(&lr, ids, 4, NULL, round == 3, NULL, &err);
+            st = sl_lr_refine_basis(&lr, ids, 4, NULL, round == 4, NULL, &err);
+        } else {
+            uint32_t ids[3];
+            for (int q = 0; q < 3; q++)
+                ids[q] = (uint32_t)(urand() * (double)lr.element_count);
+            size_t inserted = 0;
+            st = sl_lr_refine_elements(&lr, ids, 3, NULL, round == 5, &inserted, &err);
+            SL_CHECK(st != SL_OK || inserted == 9); /* one rectangle per direction and element */
+            uint32_t bad = (uint32_t)lr.element_count;
+            SL_CHECK(sl_lr_refine_elements(&lr, &bad, 1, NULL, 0, NULL, &err) == SL_ERR_INVALID);
         }
         SL_CHECK_MSG(st == SL_OK, "round %d: %s", round, err.message);
         if (st != SL_OK)
             break;
-        /* A rectangle may split no function (the mesh gains it all the same);
-         * structured refinement always splits the chosen ones. */
-        SL_CHECK_MSG(round % 2 == 0 ? lr.basis_count >= before : lr.basis_count > before, "order %d%d%d round %d: %zu basis functions before and after",
-                     order[0], order[1], order[2], round, before);
-        rect_growth += round % 2 == 0 && lr.basis_count > before;
+        /* A random rectangle may split no function (the mesh gains it all the
+         * same); structured and minimal-span refinement always split one. */
+        SL_CHECK_MSG(kind == 0 ? lr.basis_count >= before : lr.basis_count > before,
+                     "order %d%d%d round %d: %zu basis functions before and after", order[0], order[1], order[2],
+                     round, before);
+        rect_growth += kind == 0 && lr.basis_count > before;
         /* A fifth of the random points per round, all of them after the last. */
-        sample_every(&lr, &pr, 0, round == 5 ? 1 : 5, &diff);
+        sample_every(&lr, &pr, 0, round == 8 ? 1 : 5, &diff);
         SL_CHECK_MSG(diff <= 1e-12 * pr.scale, "order %d%d%d dim %d round %d: f changed by %g (scale %g)",
                      order[0], order[1], order[2], dim, round, diff, pr.scale);
         SL_CHECK(sl_lr_finish(&lr, &err) == SL_OK);

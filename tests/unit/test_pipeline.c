@@ -38,7 +38,8 @@ static const struct {
 } small_datasets[] = {
     {SL_DATASET_LINES, "{\"generator\":\"tornado\",\"lines\":12,\"points\":40,\"seed\":3}"},
     {SL_DATASET_VOLUME, "{\"generator\":\"marschner_lobb\",\"size\":16,\"seed\":1}"},
-    {SL_DATASET_LR, "{\"generator\":\"lr_field\",\"field\":\"sphere\",\"degree\":2,\"cells\":4}"},
+    /* A vector LR volume, so lr_volume's streamlines trace too (a scalar one refuses them). */
+    {SL_DATASET_LR, "{\"generator\":\"lr_field\",\"field\":\"sphere\",\"degree\":2,\"cells\":4,\"components\":\"vector\"}"},
 };
 
 static sl_dataset *make_dataset(unsigned kinds, sl_err *err)

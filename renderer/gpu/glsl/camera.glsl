@@ -22,6 +22,14 @@ vec3 sl_ray_direction(vec2 frag_xy)
     return sl_forward.xyz + sx * sl_right.xyz + sy * sl_up.xyz;
 }
 
+// The distance t along the unit ray direction d from the eye at which a surface of
+// reversed-Z depth `depth` (> 0) lies: depth = near / (distance along F) and that
+// distance is t dot(d, F).
+float sl_distance_of_depth(float depth, vec3 d)
+{
+    return sl_near.x / (depth * dot(d, sl_forward.xyz));
+}
+
 // gl_FragDepth for a point p (relative to origin).
 float sl_depth_of(vec3 p)
 {
