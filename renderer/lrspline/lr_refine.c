@@ -799,6 +799,23 @@ sl_status sl_lr_refine(sl_lr_volume *lr, const sl_lr_meshrect *rects, size_t n, 
     return refine(lr, rects, n, 1, err);
 }
 
+/* Appends to r the rectangle flat in d at v spanning b's support in the
+ * other two directions (multiplicity 1); 0 when out of memory. */
+static int push_support_rect(sl_lr_meshrect **r, size_t *cap, size_t *count, const sl_lr_volume *lr,
+                             const sl_lr_basis *b, int d, double v)
+{
+    if (!grow((void **)r, cap, *count + 1, sizeof **r))
+        return 0;
+    sl_lr_meshrect *m = &(*r)[(*count)++];
+    for (int e = 0; e < 3; e++) {
+        m->lo[e] = b->knots[e][0];
+        m->hi[e] = b->knots[e][lr->order[e]];
+    }
+    m->lo[d] = m->hi[d] = v;
+    m->multiplicity = 1;
+    return 1;
+}
+
 /* The basis function on element x with the smallest support in the two
  * directions other than d (the first one on a tie). */
 static const sl_lr_basis *smallest_across(const sl_lr_volume *lr, const sl_lr_element *x, int d)
@@ -833,15 +850,8 @@ sl_status sl_lr_refine_elements(sl_lr_volume *lr, const uint32_t *elements, size
             const sl_lr_basis *b = smallest_across(lr, x, d);
             if (!b)
                 continue;
-            if (!grow((void **)&r, &cap, count + 1, sizeof *r))
+            if (!push_support_rect(&r, &cap, &count, lr, b, d, 0.5 * (x->lo[d] + x->hi[d])))
                 return free(r), nomem(err);
-            sl_lr_meshrect *m = &r[count++];
-            for (int e = 0; e < 3; e++) {
-                m->lo[e] = b->knots[e][0];
-                m->hi[e] = b->knots[e][lr->order[e]];
-            }
-            m->lo[d] = m->hi[d] = 0.5 * (x->lo[d] + x->hi[d]);
-            m->multiplicity = 1;
         }
     }
     sl_status st = count ? refine(lr, r, count, check, err) : SL_OK;
@@ -866,15 +876,8 @@ sl_status sl_lr_refine_basis(sl_lr_volume *lr, const uint32_t *ids, size_t n, co
                 double a = b->knots[d][k], z = b->knots[d][k + 1];
                 if (!(z > a) || (min_span && z - a < 2.0 * min_span[d] * (1.0 - 1e-9)))
                     continue;
-                if (!grow((void **)&r, &cap, count + 1, sizeof *r))
+                if (!push_support_rect(&r, &cap, &count, lr, b, d, 0.5 * (a + z)))
                     return free(r), nomem(err);
-                sl_lr_meshrect *m = &r[count++];
-                for (int e = 0; e < 3; e++) {
-                    m->lo[e] = b->knots[e][0];
-                    m->hi[e] = b->knots[e][lr->order[e]];
-                }
-                m->lo[d] = m->hi[d] = 0.5 * (a + z);
-                m->multiplicity = 1;
             }
     }
     sl_status st = count ? refine(lr, r, count, check, err) : SL_OK;
