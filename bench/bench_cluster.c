@@ -14,8 +14,6 @@
  * asserts nothing. Threads: main runs the phases, one thread per client while a phase runs.
  */
 #include <dirent.h>
-#include <libgen.h>
-#include <limits.h>
 #include <pthread.h>
 #include <stdatomic.h>
 
@@ -752,15 +750,7 @@ int main(int argc, char **argv)
             return usage();
     }
     signal(SIGPIPE, SIG_IGN);
-    if (!getenv("SIGHTLINE_BINARY_DIR")) {
-        char exe[PATH_MAX];
-        ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-        if (n > 0) {
-            exe[n] = 0;
-            char *bin = dirname(exe); /* build/bin */
-            setenv("SIGHTLINE_BINARY_DIR", dirname(bin), 1);
-        }
-    }
+    harness_default_binary_dir();
     if (!getenv("SIGHTLINE_SOURCE_DIR"))
         setenv("SIGHTLINE_SOURCE_DIR", SIGHTLINE_SOURCE_DIR, 1);
 

@@ -17,7 +17,6 @@
  * scale the server settled on, and the time from the drag's `end` to the
  * full-size still. Prints Markdown; asserts nothing (tests do).
  */
-#include <libgen.h>
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
@@ -405,15 +404,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (!getenv("SIGHTLINE_BINARY_DIR")) {
-        char exe[PATH_MAX];
-        ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-        if (n > 0) {
-            exe[n] = 0;
-            char *bin = dirname(exe);       /* build/bin */
-            setenv("SIGHTLINE_BINARY_DIR", dirname(bin), 1);
-        }
-    }
+    harness_default_binary_dir();
     const char *src = getenv("SIGHTLINE_SOURCE_DIR");
     if (!src) {
         setenv("SIGHTLINE_SOURCE_DIR", SIGHTLINE_SOURCE_DIR, 1);

@@ -23,6 +23,8 @@
 #include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <libgen.h>
+#include <limits.h>
 #include <math.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -53,6 +55,21 @@ typedef struct harness {
     char db[300];
     char exe[1024];
 } harness;
+
+/* A benchmark run by hand has no ctest environment: SIGHTLINE_BINARY_DIR
+ * defaults to the build folder of the running program (its bin/'s parent). */
+static __attribute__((unused)) void harness_default_binary_dir(void)
+{
+    if (getenv("SIGHTLINE_BINARY_DIR"))
+        return;
+    char exe[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n > 0) {
+        exe[n] = 0;
+        char *bin = dirname(exe); /* build/bin */
+        setenv("SIGHTLINE_BINARY_DIR", dirname(bin), 1);
+    }
+}
 
 static __attribute__((unused)) int harness_run_wait(char *const argv[])
 {
