@@ -19,9 +19,10 @@
  * images' difference. Streamline tubes (third table): the cost of the tubes
  * in the frame (lr_field sphere as a vector field, the same grading): ms per
  * frame without them and with 64 / 256 seeds (rk4, mixed precision, the
- * default heuristic step), the trace's one-time cost (trace + tubes prepare,
- * the first frame's rebuild_ms) apart, and the orbit's frames after it (the
- * cache holds: no frame traces again). Wood-grain (fourth table): uniform 2 and 1, adaptive
+ * default heuristic step), the one-time costs apart: the prepare (Bézier
+ * blocks, proxy, upload, and with streamlines the trace and the tubes'
+ * prepare) and of it the trace (flow program, dispatch, read-back) and the
+ * tubes' prepare; then the orbit's frames (no frame traces again). Wood-grain (fourth table): uniform 2 and 1, adaptive
  * d = 0 and 1, each with samples at segment midpoints and with the
  * per-pixel jitter (parameter `jitter`), the error of the whole frame at the
  * bench size against uniform 1/32 without jitter at that size: mean, max and
@@ -251,6 +252,15 @@ static sl_status woodgrain_table(sl_pipeline *p, const sl_technique *t, const sl
     return st;
 }
 
+/* The prepare's extra `name` of a frame that prepared; 0 when absent. */
+static double prepare_extra(const sl_frame_stats *fs, const char *name)
+{
+    for (int i = 0; fs->prepared && i < fs->prepare.extra_count; i++)
+        if (strcmp(fs->prepare.extra[i].name, name) == 0)
+            return fs->prepare.extra[i].value;
+    return 0.0;
+}
+
 /* Frames with streamline tubes against the volume alone (same view and TF). */
 static sl_status streamline_table(sl_gpu *gpu, const sl_bench_options *bo, sl_err *err)
 {
@@ -264,17 +274,21 @@ static sl_status streamline_table(sl_gpu *gpu, const sl_bench_options *bo, sl_er
     };
     const sl_technique *t = sl_technique_find("lr_volume");
     sl_pipeline *p = NULL;
-    sl_dataset *ds = NULL;
     sl_status st = sl_pipeline_create(gpu, &p, err);
-    if (st == SL_OK && (st = sl_generate_json(FIELD, &ds, err)) == SL_OK)
-        sl_pipeline_set_dataset(p, ds);
     if (st == SL_OK)
         printf("\n## lr_volume: streamline tubes in the frame\n\n%s; timing at %dx%d, median of %d "
-               "orbit frames after the first (which traces: its rebuild ms is the trace + tubes prepare)\n\n"
-               "| streamlines | seeds | trace + tubes prepare ms (once) | ms / frame | ratio to the volume alone |\n"
-               "|---|---|---|---|---|\n", FIELD, bo->width, bo->height, bo->frames);
+               "orbit frames after the first (which prepares: blocks, proxy, upload, and the trace and the tubes' "
+               "prepare)\n\n"
+               "| streamlines | seeds | samples | prepare ms (once) | of it trace ms | of it tubes ms | ms / frame | "
+               "ratio to the volume alone |\n"
+               "|---|---|---|---|---|---|---|---|\n", FIELD, bo->width, bo->height, bo->frames);
     double alone = 0;
     for (size_t r = 0; r < sizeof rows / sizeof rows[0] && st == SL_OK; r++) {
+        /* A fresh dataset per row, so every row's first frame prepares (and traces there). */
+        sl_dataset *ds = NULL;
+        if ((st = sl_generate_json(FIELD, &ds, err)) != SL_OK)
+            break;
+        sl_pipeline_set_dataset(p, ds);
         sl_params q;
         sl_params_init(&q, t->params, t->param_count);
         cJSON *base = cJSON_Parse(BASE_PARAMS), *extra = cJSON_Parse(rows[r]);
@@ -295,8 +309,10 @@ static sl_status streamline_table(sl_gpu *gpu, const sl_bench_options *bo, sl_er
         if (r == 0)
             alone = tm.median_ms;
         int seeds = r == 0 ? 0 : r == 1 ? 64 : 256;
-        printf("| %s | %d | %.0f | %.1f | %.2f |\n", r == 0 ? "off" : r == 1 ? "64 seeds" : "256 seeds", seeds,
-               fs.render.rebuild_ms, tm.median_ms, alone > 0 ? tm.median_ms / alone : 0.0);
+        printf("| %s | %d | %.0f | %.0f | %.0f | %.0f | %.1f | %.2f |\n", r == 0 ? "off" : r == 1 ? "64 seeds" : "256 seeds",
+               seeds, prepare_extra(&fs, "streamline_samples"), fs.prepare_ms,
+               prepare_extra(&fs, "streamline_trace_ms"), prepare_extra(&fs, "streamline_tubes_ms"), tm.median_ms,
+               alone > 0 ? tm.median_ms / alone : 0.0);
         fflush(stdout);
     }
     sl_pipeline_destroy(p);

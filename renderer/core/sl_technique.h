@@ -41,9 +41,10 @@ typedef struct sl_render_stats {
                                 (voxel_lines: lines beyond the per-voxel cap) */
     double samples;          /* ray marchers: samples evaluated */
     double samples_skipped;  /* ray marchers: samples jumped over by empty-space skipping */
-    double rebuild_ms;       /* derived data this render rebuilt because a FRAME-level
-                                parameter changed it (lr_volume: the streamline trace and
-                                its tubes); 0 when the technique's cache held */
+    double rebuild_ms;       /* derived data this render built because a FRAME-level
+                                parameter asked for it (lr_volume: the streamline trace and
+                                its tubes when `streamlines` is turned on after the
+                                prepare); 0 when the technique's cache held */
 } sl_render_stats;
 
 /* A named number of a technique's own ("set0.particles"), so callers can

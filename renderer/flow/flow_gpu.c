@@ -1,9 +1,10 @@
 /* flow_gpu.c — the compute-shader streamline driver (flow_gpu.h): field
- * texture (regular, flow_field_gpu.c) or Bézier blocks and element look-up (LR, built and
- * uploaded once in create, bound per trace), one program per precision, the tableau of sl_flow_methods as
- * uniforms (doubles for mixed / double, so both paths run the same
- * coefficients; b - e subtracted here), seed / sample / info buffers,
- * dispatch, read-back. Render thread only.
+ * texture (regular, flow_field_gpu.c) or Bézier blocks and element look-up
+ * (LR: built and uploaded once in create, or borrowed from a renderer that
+ * has them; bound per trace), one program per precision, the tableau of
+ * sl_flow_methods as uniforms (doubles for mixed / double, so both paths run
+ * the same coefficients; b - e subtracted here), seed / sample / info
+ * buffers, dispatch, read-back. Render thread only.
  */
 #include <math.h>
 #include <stdio.h>
@@ -22,10 +23,13 @@ struct sl_flow_gpu {
     GLuint texture;
     GLuint programs[VARIANTS];
     int has_double;
-    /* LR: the blocks and look-up (bz) and their GPU buffers (blocks) */
-    int has_lr;
-    sl_lr_bezier bz;
-    sl_lr_bezier_gpu blocks;
+    /* LR: the blocks and look-up (bz) and their GPU buffers (blocks), either
+     * borrowed (sl_flow_gpu_create_lr) or own_bz / own_blocks (owns_blocks) */
+    int has_lr, owns_blocks;
+    const sl_lr_bezier *bz;
+    const sl_lr_bezier_gpu *blocks;
+    sl_lr_bezier own_bz;
+    sl_lr_bezier_gpu own_blocks;
 };
 
 const char *const sl_flow_precision_names[4] = {"single", "mixed", "double", NULL};
@@ -48,29 +52,64 @@ static int has_doubles(void)
     return epoxy_gl_version() >= 40 || epoxy_has_gl_extension("GL_ARB_gpu_shader_fp64");
 }
 
-/* LR: the Bézier blocks with the look-up (auto kind), uploaded with the
- * double copies when GL has doubles (mixed needs the double boxes too). */
-static sl_status create_lr(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
+/* The state of an LR field of dim 3 without its blocks yet. */
+static sl_status lr_state(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
 {
-    if (!f->lr || f->lr->dim != 3)
+    *out = NULL;
+    if (f->kind != SL_FLOW_FIELD_LR || !f->lr || f->lr->dim != 3)
         return sl_err_set(err, SL_ERR_UNSUPPORTED, "GPU streamlines need an LR-spline volume of dim 3 (got dim %d)",
                           f->lr ? f->lr->dim : 0);
     sl_flow_gpu *g = calloc(1, sizeof *g);
     if (!g)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the GPU streamline state");
     g->field = *f;
+    g->field.lr = NULL; /* borrowed only during create */
     g->has_double = has_doubles();
     g->has_lr = 1;
-    sl_status st = sl_lr_bezier_build(f->lr, SL_LR_LOOKUP_AUTO, 0, &g->bz, err);
+    *out = g;
+    return SL_OK;
+}
+
+/* LR: the Bézier blocks with the look-up (auto kind), uploaded with the
+ * double copies when GL has doubles (mixed needs the double boxes too). */
+static sl_status create_lr(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err)
+{
+    sl_flow_gpu *g;
+    sl_status st = lr_state(f, &g, err);
+    if (st != SL_OK)
+        return st;
+    g->owns_blocks = 1;
+    g->bz = &g->own_bz;
+    g->blocks = &g->own_blocks;
+    st = sl_lr_bezier_build(f->lr, SL_LR_LOOKUP_AUTO, 0, &g->own_bz, err);
     sl_err stale = {0};
     sl_gl_check_errors("before the LR field upload", &stale); /* clears errors not ours */
     if (st == SL_OK)
-        st = sl_lr_bezier_upload(&g->bz, g->has_double, &g->blocks, err);
+        st = sl_lr_bezier_upload(&g->own_bz, g->has_double, &g->own_blocks, err);
     if (st != SL_OK) {
         sl_flow_gpu_destroy(g);
         return st;
     }
-    g->field.lr = NULL; /* borrowed only during create */
+    *out = g;
+    return SL_OK;
+}
+
+sl_status sl_flow_gpu_create_lr(const sl_flow_field *f, const sl_lr_bezier *bz, const sl_lr_bezier_gpu *blocks,
+                                sl_flow_gpu **out, sl_err *err)
+{
+    *out = NULL;
+    if (f->kind == SL_FLOW_FIELD_LR && f->lr &&
+        (bz->dim != f->lr->dim || bz->element_count != f->lr->element_count ||
+         blocks->element_count != bz->element_count))
+        return sl_err_set(err, SL_ERR_INVALID,
+                          "the Bézier blocks (%zu elements, dim %d) are not those of this LR field (%zu, dim %d)",
+                          bz->element_count, bz->dim, f->lr->element_count, f->lr->dim);
+    sl_flow_gpu *g;
+    sl_status st = lr_state(f, &g, err);
+    if (st != SL_OK)
+        return st;
+    g->bz = bz;
+    g->blocks = blocks;
     *out = g;
     return SL_OK;
 }
@@ -106,9 +145,9 @@ void sl_flow_gpu_destroy(sl_flow_gpu *g)
             glDeleteProgram(g->programs[i]);
     if (g->texture)
         glDeleteTextures(1, &g->texture);
-    if (g->has_lr) {
-        sl_lr_bezier_release(&g->blocks);
-        sl_lr_bezier_free(&g->bz);
+    if (g->owns_blocks) {
+        sl_lr_bezier_release(&g->own_blocks);
+        sl_lr_bezier_free(&g->own_bz);
     }
     free(g);
 }
@@ -122,7 +161,7 @@ static sl_status program_for(sl_flow_gpu *g, sl_flow_precision p, GLuint *progra
     char defines[512];
     int used = snprintf(defines, sizeof defines, "#define SL_PREC %d\n", (int)p);
     if (g->has_lr)
-        sl_lr_bezier_defines(&g->bz, p != SL_FLOW_SINGLE, defines + used, sizeof defines - (size_t)used);
+        sl_lr_bezier_defines(g->bz, p != SL_FLOW_SINGLE, defines + used, sizeof defines - (size_t)used);
     sl_program_desc d = {.compute = g->has_lr ? "flow/flow_trace_lr.comp.glsl" : "flow/flow_trace_regular.comp.glsl",
                          .defines = defines, .label = g->has_lr ? "flow_trace_lr" : "flow_trace"};
     sl_status st = sl_gl_program_create(&d, &g->programs[p], err);
@@ -197,6 +236,10 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
         return sl_err_set(err, SL_ERR_UNSUPPORTED,
                           "%s precision needs GL doubles (GL_ARB_gpu_shader_fp64), which this GPU lacks",
                           sl_flow_precision_name(precision));
+    if (precision != SL_FLOW_SINGLE && g->has_lr && !g->blocks->box_buffer_d)
+        return sl_err_set(err, SL_ERR_INVALID,
+                          "%s precision reads the Bézier blocks in double, which were uploaded without them "
+                          "(sl_lr_bezier_upload_double)", sl_flow_precision_name(precision));
     if (seed_count == 0)
         return sl_err_set(err, SL_ERR_INVALID, "no seeds to trace");
     const sl_flow_method *m = &sl_flow_methods[o->solver];
@@ -246,8 +289,8 @@ sl_status sl_flow_gpu_trace(sl_flow_gpu *g, const double *seeds, size_t seed_cou
     const sl_flow_field *f = &g->field;
     glUseProgram(program);
     if (g->has_lr) {
-        sl_lr_bezier_set_uniforms(program, &g->bz);
-        sl_lr_bezier_bind(&g->blocks, program);
+        sl_lr_bezier_set_uniforms(program, g->bz);
+        sl_lr_bezier_bind(g->blocks, program);
     } else {
         sl_flow_field_texture_bind(program, f, g->texture, precision != SL_FLOW_SINGLE);
     }

@@ -15,7 +15,8 @@
  * with the CPU's trilinear order of operations (flow_field_regular.glsl);
  * LR-spline volumes of dim 3 as the Bézier blocks and element look-up of
  * lrspline/sl_lr_bezier.h (flow_field_lr.glsl; SSBO bindings 6..12, flow's
- * own 0..2), built from the model once in create; their heuristic step is
+ * own 0..2), built from the model once in create or borrowed from the
+ * renderer that built them (sl_flow_gpu_create_lr); their heuristic step is
  * per point (the element's min side / 2^degree, as sl_flow_local_size).
  * Render thread only, GL context current. Not done here: drawing (the
  * result goes through sl_flow_result_to_dataset to renderer/tubes).
@@ -25,6 +26,7 @@
 
 #include <epoxy/gl.h>
 
+#include "../lrspline/sl_lr_bezier.h"
 #include "sl_flow.h"
 
 typedef enum sl_flow_precision {
@@ -55,6 +57,16 @@ void sl_flow_field_texture_bind(GLuint program, const sl_flow_field *f, GLuint t
  * (SL_ERR_NOMEM, SL_ERR_LIMIT), SL_ERR_GPU on GL failure. The field's
  * volume or LR model is borrowed only during the call. */
 sl_status sl_flow_gpu_create(const sl_flow_field *f, sl_flow_gpu **out, sl_err *err);
+/* An LR field of dim 3 over Bézier blocks and a look-up already built and
+ * uploaded by the caller (lr_volume's prepare: any look-up kind), borrowed
+ * instead of built again: bz and blocks must outlive the state and stay
+ * where they are. Mixed and double traces read the double buffers, which
+ * the caller adds first (sl_lr_bezier_upload_double; a trace without them is
+ * SL_ERR_INVALID). SL_ERR_INVALID when the blocks are not the field's (element
+ * count, dim), SL_ERR_UNSUPPORTED for a field that is not an LR volume of
+ * dim 3, SL_ERR_NOMEM. */
+sl_status sl_flow_gpu_create_lr(const sl_flow_field *f, const sl_lr_bezier *bz, const sl_lr_bezier_gpu *blocks,
+                                sl_flow_gpu **out, sl_err *err);
 void sl_flow_gpu_destroy(sl_flow_gpu *g); /* NULL is fine */
 
 /* Traces one line per seed; *out as sl_flow_trace (samples converted to

@@ -10,14 +10,15 @@
  * renderer/volume/ code). render: one full-screen pass of lr_volume.frag.glsl
  * (the model: README.md); the transfer function is baked into volume_dvr's
  * table and texture (re-baked only when it changes, with the per-element
- * visibility of the hulls). Every parameter is FRAME level but the look-up's.
- * Scalar volumes, and vector volumes (dim 3) by their magnitude. With
- * `streamlines` (vector volumes) the lines traced from a seed box are drawn
- * first as tubes (lr_volume_streamlines.c: the trace is cached and redone
- * only when a parameter that shapes the lines changes), their depth is
- * copied, and the rays end there and are blended over them (premultiplied,
- * ONE, ONE_MINUS_SRC_ALPHA); without, the shader composites the background
- * itself as before. Render thread only.
+ * visibility of the hulls). Scalar volumes, and vector volumes (dim 3) by
+ * their magnitude. With `streamlines` (vector volumes) the lines traced from
+ * a seed box over these same blocks are drawn first as tubes
+ * (lr_volume_streamlines.c), their depth is copied, and the rays end there
+ * and are blended over them (premultiplied, ONE, ONE_MINUS_SRC_ALPHA);
+ * without, the shader composites the background itself. PREPARED level: the
+ * look-up and what shapes the lines (prepare traces when `streamlines` is
+ * on; turned on later, the next render traces once); FRAME: the rest.
+ * Render thread only.
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +28,7 @@
 #include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
+#include "../flow/flow_gpu.h"
 #include "../gpu/sl_gpu.h"
 #include "../lrspline/sl_lr.h"
 #include "../lrspline/sl_lr_bezier.h"
@@ -76,25 +78,25 @@ static const sl_param_def lr_volume_params[] = {
      "vector volumes: streamlines from the seed box, traced on the GPU and drawn as tubes coloured by speed, "
      "the volume composited in front of them", SL_INVALIDATE_FRAME},
     {"seed_min", SL_PARAM_VEC3, 0.0, 1.0, {0.1, 0.1, 0.1}, NULL, "domain",
-     "streamlines: one corner of the seed box, in fractions of the domain", SL_INVALIDATE_FRAME},
+     "streamlines: one corner of the seed box, in fractions of the domain", SL_INVALIDATE_PREPARED},
     {"seed_max", SL_PARAM_VEC3, 0.0, 1.0, {0.9, 0.9, 0.9}, NULL, "domain",
-     "streamlines: the opposite corner of the seed box", SL_INVALIDATE_FRAME},
+     "streamlines: the opposite corner of the seed box", SL_INVALIDATE_PREPARED},
     {"seed_count", SL_PARAM_INT, 1, 4096, {64}, NULL, "",
-     "streamlines: seeds in the box (Halton points, deterministic)", SL_INVALIDATE_FRAME},
+     "streamlines: seeds in the box (Halton points, deterministic)", SL_INVALIDATE_PREPARED},
     {"solver", SL_PARAM_ENUM, 0, 0, {SL_FLOW_RK4}, sl_flow_solver_names, "",
      "streamlines: Runge-Kutta method; he, bs and rkf45 adapt their step to flow_tol, the others take the "
-     "paper's heuristic step", SL_INVALIDATE_FRAME},
+     "paper's heuristic step", SL_INVALIDATE_PREPARED},
     {"flow_step", SL_PARAM_FLOAT, 0.01, 16.0, {1.0}, NULL, "element",
      "streamlines, fixed-step solvers: h = flow_step x the element's smallest side / 2^degree (paper Eq. 4)",
-     SL_INVALIDATE_FRAME},
+     SL_INVALIDATE_PREPARED},
     {"flow_tol", SL_PARAM_FLOAT, 1e-12, 1.0, {1e-6}, NULL, "world",
-     "streamlines, adaptive solvers: largest error of a step (embedded pair)", SL_INVALIDATE_FRAME},
+     "streamlines, adaptive solvers: largest error of a step (embedded pair)", SL_INVALIDATE_PREPARED},
     {"t_max", SL_PARAM_FLOAT, 1e-6, 1e6, {10.0}, NULL, "time", "streamlines: integration time per line",
-     SL_INVALIDATE_FRAME},
+     SL_INVALIDATE_PREPARED},
     {"max_samples", SL_PARAM_INT, 2, 100000, {2000}, NULL, "", "streamlines: samples per line at most",
-     SL_INVALIDATE_FRAME},
+     SL_INVALIDATE_PREPARED},
     {"precision", SL_PARAM_ENUM, 0, 0, {SL_FLOW_MIXED}, sl_flow_precision_names, "",
-     "streamlines: single, mixed (double update, float spline) or double (paper 5.6)", SL_INVALIDATE_FRAME},
+     "streamlines: single, mixed (double update, float spline) or double (paper 5.6)", SL_INVALIDATE_PREPARED},
     {"tube_radius", SL_PARAM_FLOAT, 0.0, 0.1, {0.003}, NULL, "domain diagonal",
      "streamlines: tube radius as a fraction of the domain's diagonal; 0 = the tubes' automatic radius "
      "(1/300 of the lines' bounding radius)", SL_INVALIDATE_FRAME},
@@ -117,8 +119,8 @@ typedef struct lr_volume_state {
     int tf_valid;
     size_t visible_elements;
     double ref;                    /* the smallest element side (world) */
-    lrv_streamlines streamlines;   /* traced and prepared at the first frame that asks */
-    size_t gpu_bytes;
+    lrv_streamlines streamlines;   /* traced in prepare, or at the first frame that asks */
+    size_t gpu_bytes;              /* without the blocks (blocks.bytes grows with their double copies) */
     sl_prepare_stats prep;
 } lr_volume_state;
 
@@ -217,7 +219,7 @@ static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
     if (!s)
         return sl_err_set(err, SL_ERR_NOMEM, "lr_volume: out of memory");
     s->lr = ds->lr;
-    lrv_streamlines_init(&s->streamlines, gpu, ds);
+    lrv_streamlines_init(&s->streamlines, gpu, ds, &s->bz, &s->blocks);
     s->ref = fmin(fmin(ds->lr->min_side[0], ds->lr->min_side[1]), ds->lr->min_side[2]);
     double t_pre = sl_clock_ms();
     sl_status st = sl_lr_bezier_build(s->lr, (sl_lr_lookup_kind)sl_params_choice(params, "lookup"),
@@ -246,10 +248,22 @@ static sl_status lr_volume_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_p
         lr_volume_release(s);
         return st;
     }
-    s->gpu_bytes = s->blocks.bytes + SL_VOLUME_TF_TEXELS * 16 + sizeof(GLuint) * s->bz.element_count;
+    s->gpu_bytes = SL_VOLUME_TF_TEXELS * 16 + sizeof(GLuint) * s->bz.element_count;
     sl_prepare_stats_add(&s->prep, "elements", (double)s->bz.element_count);
     sl_prepare_stats_add(&s->prep, "block_bytes", (double)s->blocks.bytes);
     sl_prepare_stats_add(&s->prep, "min_side", s->ref);
+    if (sl_params_bool(params, "streamlines")) {
+        const lrv_streamlines *l = &s->streamlines;
+        if ((st = lrv_streamlines_trace(&s->streamlines, params, err)) != SL_OK) {
+            lr_volume_release(s);
+            return st;
+        }
+        sl_prepare_stats_add(&s->prep, "streamlines", (double)l->line_count);
+        sl_prepare_stats_add(&s->prep, "streamline_samples", (double)l->sample_count);
+        sl_prepare_stats_add(&s->prep, "streamline_trace_ms", l->trace_ms);
+        sl_prepare_stats_add(&s->prep, "streamline_compute_ms", l->compute_ms);
+        sl_prepare_stats_add(&s->prep, "streamline_tubes_ms", l->tubes_ms);
+    }
     *out = s;
     return SL_OK;
 }
@@ -308,10 +322,16 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
     sl_status st = program_for(s, mode, &p, err);
     if (st != SL_OK)
         return st;
-    /* Streamlines first: the tubes' depth ends the rays, which blend over them. */
+    /* Streamlines first: the tubes' depth ends the rays, which blend over them.
+     * Turned on after the prepare (FRAME level), this frame traces once. */
     int over = sl_params_bool(params, "streamlines");
-    if (over && ((st = lrv_streamlines_update(&s->streamlines, params, &stats->rebuild_ms, err)) != SL_OK ||
-                 (st = lrv_streamlines_draw(&s->streamlines, view, params, target, stats, err)) != SL_OK))
+    if (over && !s->streamlines.traced) {
+        double t0 = sl_clock_ms();
+        if ((st = lrv_streamlines_trace(&s->streamlines, params, err)) != SL_OK)
+            return st;
+        stats->rebuild_ms = sl_clock_ms() - t0;
+    }
+    if (over && (st = lrv_streamlines_draw(&s->streamlines, view, params, target, stats, err)) != SL_OK)
         return st;
     update_tf(s, sl_params_transfer(params, "transfer_function"));
     if (view->height > s->rows_capacity) {
@@ -398,7 +418,7 @@ static void lr_volume_prepare_stats(const void *opaque, sl_prepare_stats *out)
 static size_t lr_volume_gpu_bytes(const void *opaque)
 {
     const lr_volume_state *s = opaque;
-    return s ? s->gpu_bytes + lrv_streamlines_gpu_bytes(&s->streamlines) : 0;
+    return s ? s->gpu_bytes + s->blocks.bytes + lrv_streamlines_gpu_bytes(&s->streamlines) : 0;
 }
 
 const sl_technique sl_lr_volume_technique = {

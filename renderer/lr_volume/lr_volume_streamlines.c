@@ -1,5 +1,5 @@
-/* lr_volume_streamlines.c — streamlines traced on the GPU and drawn as
- * tubes in lr_volume's frame (lr_volume_streamlines.h).
+/* lr_volume_streamlines.c — streamlines traced on the GPU over lr_volume's
+ * Bézier blocks and drawn as tubes in its frame (lr_volume_streamlines.h).
  *
  * Fixed-step solvers take the paper's heuristic step (h = flow_step x the
  * element's min side / 2^degree, Eq. 4), adaptive ones (he, bs, rkf45) the
@@ -17,13 +17,17 @@
 #include <string.h>
 
 #include "../core/sl_clock.h"
+#include "../flow/flow_gpu.h"
 #include "../flow/sl_flow.h"
 
-void lrv_streamlines_init(lrv_streamlines *s, sl_gpu *gpu, const sl_dataset *dataset)
+void lrv_streamlines_init(lrv_streamlines *s, sl_gpu *gpu, const sl_dataset *dataset, const sl_lr_bezier *bz,
+                          sl_lr_bezier_gpu *blocks)
 {
     memset(s, 0, sizeof *s);
     s->gpu = gpu;
     s->dataset = dataset;
+    s->bz = bz;
+    s->blocks = blocks;
 }
 
 static void drop_lines(lrv_streamlines *s)
@@ -42,7 +46,6 @@ void lrv_streamlines_deinit(lrv_streamlines *s)
     if (!s)
         return;
     drop_lines(s);
-    sl_flow_gpu_destroy(s->flow);
     sl_depth_copy_deinit(&s->depth);
     memset(s, 0, sizeof *s);
 }
@@ -53,114 +56,112 @@ size_t lrv_streamlines_gpu_bytes(const lrv_streamlines *s)
     return tubes + sl_depth_copy_bytes(&s->depth);
 }
 
-static void key_from_params(const sl_params *p, lrv_trace_key *k)
-{
-    memset(k, 0, sizeof *k);
-    float lo[3], hi[3];
-    sl_params_vec3(p, "seed_min", lo);
-    sl_params_vec3(p, "seed_max", hi);
-    for (int a = 0; a < 3; a++) {
-        k->seed_lo[a] = lo[a];
-        k->seed_hi[a] = hi[a];
-    }
-    k->seed_count = sl_params_int(p, "seed_count");
-    k->solver = sl_params_choice(p, "solver");
-    k->precision = sl_params_choice(p, "precision");
-    k->step = sl_params_float(p, "flow_step");
-    k->tol = sl_params_float(p, "flow_tol");
-    k->t_max = sl_params_float(p, "t_max");
-    k->max_samples = sl_params_int(p, "max_samples");
-}
-
-/* The seeds of the key: Halton points (flow's box seeds) in the seed box,
+/* The seeds of params: Halton points (flow's box seeds) in the seed box,
  * given in fractions of the domain, the corners sorted. */
-static sl_status make_seeds(const lrv_streamlines *s, const lrv_trace_key *k, double **seeds, size_t *count,
+static sl_status make_seeds(const lrv_streamlines *s, const sl_params *p, double **seeds, size_t *count,
                             sl_err *err)
 {
     const sl_lr_volume *lr = s->dataset->lr;
+    float a_frac[3], b_frac[3];
+    sl_params_vec3(p, "seed_min", a_frac);
+    sl_params_vec3(p, "seed_max", b_frac);
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         double ext = lr->domain_hi[a] - lr->domain_lo[a];
-        lo[a] = lr->domain_lo[a] + ext * fmin(k->seed_lo[a], k->seed_hi[a]);
-        hi[a] = lr->domain_lo[a] + ext * fmax(k->seed_lo[a], k->seed_hi[a]);
+        lo[a] = lr->domain_lo[a] + ext * fmin(a_frac[a], b_frac[a]);
+        hi[a] = lr->domain_lo[a] + ext * fmax(a_frac[a], b_frac[a]);
     }
     char spec[320];
     snprintf(spec, sizeof spec, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
-             k->seed_count);
+             sl_params_int(p, "seed_count"));
     return sl_flow_seeds_box(spec, seeds, count, err);
 }
 
-/* Traces the key's lines and prepares the tubes on them (nothing to draw
- * when no line has two samples: seeds where the field is zero). */
-static sl_status trace(lrv_streamlines *s, const lrv_trace_key *k, sl_err *err)
+/* The trace on the GPU over lr_volume's blocks: the flow state lives for
+ * this one call (a state traces once), the blocks gain their double copies
+ * for mixed and double precision. */
+static sl_status trace_lines(lrv_streamlines *s, const sl_params *p, sl_flow_result *r, sl_err *err)
 {
     sl_flow_field field;
     sl_status st = sl_flow_field_from_dataset(&field, s->dataset, err);
-    if (st != SL_OK)
+    if (st != SL_OK || s->dataset->lr->dim != 3)
         return sl_err_set(err, SL_ERR_INVALID,
-                          "streamlines need a vector LR-spline volume (3 components); this one has %d",
+                          "the volume has %d component(s); streamlines need a vector LR-spline volume (3)",
                           s->dataset->lr->dim);
-    if (!s->flow && (st = sl_flow_gpu_create(&field, &s->flow, err)) != SL_OK)
-        return st;
-    int adaptive = sl_flow_methods[k->solver].embedded_order > 0;
-    sl_flow_options o = {.solver = (sl_flow_solver)k->solver,
+    int solver = sl_params_choice(p, "solver");
+    sl_flow_precision precision = (sl_flow_precision)sl_params_choice(p, "precision");
+    int adaptive = sl_flow_methods[solver].embedded_order > 0;
+    sl_flow_options o = {.solver = (sl_flow_solver)solver,
                          .mode = adaptive ? SL_FLOW_STEP_ADAPTIVE : SL_FLOW_STEP_HEURISTIC,
-                         .step = adaptive ? 0.0 : k->step,
-                         .tol = k->tol,
-                         .t_max = k->t_max,
-                         .max_samples = (size_t)k->max_samples};
+                         .step = adaptive ? 0.0 : sl_params_float(p, "flow_step"),
+                         .tol = sl_params_float(p, "flow_tol"),
+                         .t_max = sl_params_float(p, "t_max"),
+                         .max_samples = (size_t)sl_params_int(p, "max_samples")};
+    if (precision != SL_FLOW_SINGLE && (st = sl_lr_bezier_upload_double(s->bz, s->blocks, err)) != SL_OK)
+        return st;
+    sl_flow_gpu *flow = NULL;
+    if ((st = sl_flow_gpu_create_lr(&field, s->bz, s->blocks, &flow, err)) != SL_OK)
+        return st;
     double *seeds = NULL;
     size_t count = 0;
-    if ((st = make_seeds(s, k, &seeds, &count, err)) != SL_OK)
-        return st;
-    sl_flow_result r = {0};
-    double t0 = sl_clock_ms();
-    st = sl_flow_gpu_trace(s->flow, seeds, count, &o, (sl_flow_precision)k->precision, &r, NULL, err);
-    free(seeds);
-    s->trace_ms = sl_clock_ms() - t0;
-    if (st != SL_OK)
-        return st;
-    size_t samples = 0, lines = 0;
-    for (size_t i = 0; i < r.line_count; i++) {
-        samples += r.lines[i].count;
-        lines += r.lines[i].count >= 2;
+    if ((st = make_seeds(s, p, &seeds, &count, err)) == SL_OK) {
+        double t0 = sl_clock_ms();
+        st = sl_flow_gpu_trace(flow, seeds, count, &o, precision, r, &s->compute_ms, err);
+        s->trace_ms = sl_clock_ms() - t0;
     }
-    sl_dataset *ds = NULL;
-    if (lines > 0)
-        st = sl_flow_result_to_dataset(&r, "streamlines", &ds, err);
-    sl_flow_result_free(&r);
-    if (st != SL_OK)
-        return st;
-    s->lines = ds;
+    free(seeds);
+    sl_flow_gpu_destroy(flow);
+    return st;
+}
+
+/* The lines of r as a line set and the tubes prepared on it (nothing to
+ * draw when no line has two samples: seeds where the field is zero). */
+static sl_status make_tubes(lrv_streamlines *s, const sl_flow_result *r, sl_err *err)
+{
+    size_t samples = 0, lines = 0;
+    for (size_t i = 0; i < r->line_count; i++) {
+        samples += r->lines[i].count;
+        lines += r->lines[i].count >= 2;
+    }
     s->line_count = lines;
     s->sample_count = samples;
-    if (!ds)
+    if (lines == 0)
         return SL_OK;
+    sl_status st = sl_flow_result_to_dataset(r, "streamlines", &s->lines, err);
+    if (st != SL_OK)
+        return st;
     if (!s->tubes && !(s->tubes = sl_technique_find("tubes")))
         return sl_err_set(err, SL_ERR_INVALID, "streamlines: the tubes technique is not in this build");
     sl_params_init(&s->tube_params, s->tubes->params, s->tubes->param_count);
-    return s->tubes->prepare(s->gpu, ds, &s->tube_params, &s->tubes_state, err);
+    double speed = -1.0; /* the colour: the line set's "speed" attribute */
+    for (int a = 0; a < s->lines->lines.attribute_count; a++)
+        if (strcmp(s->lines->lines.attributes[a].name, "speed") == 0)
+            speed = a;
+    if (speed < 0)
+        return sl_err_set(err, SL_ERR_INVALID, "streamlines: the line set has no speed attribute");
+    if ((st = sl_params_set_numbers(&s->tube_params, "attribute", &speed, 1, err)) != SL_OK)
+        return st;
+    double t0 = sl_clock_ms();
+    st = s->tubes->prepare(s->gpu, s->lines, &s->tube_params, &s->tubes_state, err);
+    s->tubes_ms = sl_clock_ms() - t0;
+    return st;
 }
 
-sl_status lrv_streamlines_update(lrv_streamlines *s, const sl_params *params, double *rebuild_ms, sl_err *err)
+sl_status lrv_streamlines_trace(lrv_streamlines *s, const sl_params *params, sl_err *err)
 {
-    *rebuild_ms = 0.0;
-    lrv_trace_key k;
-    key_from_params(params, &k);
-    if (s->traced && memcmp(&k, &s->key, sizeof k) == 0)
+    if (s->traced)
         return SL_OK;
-    double t0 = sl_clock_ms();
-    drop_lines(s);
-    sl_status st = trace(s, &k, err);
+    sl_flow_result r = {0};
+    sl_status st = trace_lines(s, params, &r, err);
+    if (st == SL_OK)
+        st = make_tubes(s, &r, err);
+    sl_flow_result_free(&r);
     if (st != SL_OK) {
         drop_lines(s);
         sl_err_prefix(err, "lr_volume: streamlines");
         return st;
     }
-    s->key = k;
     s->traced = 1;
-    s->traces++;
-    *rebuild_ms = sl_clock_ms() - t0;
     return SL_OK;
 }
 

@@ -57,33 +57,48 @@ sl_status sl_lr_bezier_upload(const sl_lr_bezier *bz, int want_double, sl_lr_bez
     gpu->bytes = sizeof(float) * (8 * ne + nc);
     free(box);
     free(coef);
-    if (st == SL_OK && want_double) {
-        double *boxd = malloc(sizeof(double) * 8 * ne);
-        if (!boxd) {
-            st = sl_err_set(err, SL_ERR_NOMEM, "out of memory packing %zu double Bézier blocks", ne);
-        } else {
-            for (size_t e = 0; e < ne; e++) {
-                for (int d = 0; d < 3; d++) {
-                    boxd[e * 8 + (size_t)d] = bz->lo[e * 3 + (size_t)d];
-                    boxd[e * 8 + 4 + (size_t)d] = bz->hi[e * 3 + (size_t)d];
-                }
-                boxd[e * 8 + 3] = bz->hull_min[e];
-                boxd[e * 8 + 7] = bz->hull_max[e];
-            }
-            st = make_buffer(&gpu->box_buffer_d, boxd, sizeof(double) * 8 * ne, "LR double block boxes", err);
-            if (st == SL_OK)
-                st = make_buffer(&gpu->coef_buffer_d, bz->coef, sizeof(double) * (nc ? nc : 1),
-                                 "LR double block coefficients", err);
-            gpu->bytes += sizeof(double) * (8 * ne + nc);
-            free(boxd);
-        }
-    }
+    if (st == SL_OK && want_double)
+        st = sl_lr_bezier_upload_double(bz, gpu, err);
     if (st == SL_OK)
         st = lookup_upload(bz, gpu, err);
     gpu->element_count = ne;
     if (st != SL_OK)
         sl_lr_bezier_release(gpu);
     return st;
+}
+
+sl_status sl_lr_bezier_upload_double(const sl_lr_bezier *bz, sl_lr_bezier_gpu *gpu, sl_err *err)
+{
+    if (gpu->box_buffer_d)
+        return SL_OK;
+    size_t ne = bz->element_count, nc = ne * bz->stride;
+    double *boxd = malloc(sizeof(double) * 8 * (ne ? ne : 1));
+    if (!boxd)
+        return sl_err_set(err, SL_ERR_NOMEM, "out of memory packing %zu double Bézier blocks", ne);
+    for (size_t e = 0; e < ne; e++) {
+        for (int d = 0; d < 3; d++) {
+            boxd[e * 8 + (size_t)d] = bz->lo[e * 3 + (size_t)d];
+            boxd[e * 8 + 4 + (size_t)d] = bz->hi[e * 3 + (size_t)d];
+        }
+        boxd[e * 8 + 3] = bz->hull_min[e];
+        boxd[e * 8 + 7] = bz->hull_max[e];
+    }
+    GLuint box = 0, coef = 0;
+    sl_status st = make_buffer(&box, boxd, sizeof(double) * 8 * ne, "LR double block boxes", err);
+    if (st == SL_OK)
+        st = make_buffer(&coef, bz->coef, sizeof(double) * (nc ? nc : 1), "LR double block coefficients", err);
+    free(boxd);
+    if (st != SL_OK) {
+        GLuint b[2] = {box, coef};
+        for (int i = 0; i < 2; i++)
+            if (b[i])
+                glDeleteBuffers(1, &b[i]);
+        return st;
+    }
+    gpu->box_buffer_d = box;
+    gpu->coef_buffer_d = coef;
+    gpu->bytes += sizeof(double) * (8 * ne + nc);
+    return SL_OK;
 }
 
 void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu, unsigned program)

@@ -101,6 +101,11 @@ typedef struct sl_lr_bezier_gpu {
 #define SL_LR_COEF_BINDING_D 9
 
 sl_status sl_lr_bezier_upload(const sl_lr_bezier *bz, int want_double, sl_lr_bezier_gpu *gpu, sl_err *err);
+/* Adds the double buffers to blocks uploaded without them (nothing when
+ * present), so a double program can share blocks first made for float
+ * (lr_volume's streamlines). SL_ERR_NOMEM, SL_ERR_GPU; on failure gpu is
+ * unchanged. */
+sl_status sl_lr_bezier_upload_double(const sl_lr_bezier *bz, sl_lr_bezier_gpu *gpu, sl_err *err);
 /* Binds the buffers to their bindings (the double ones when present) and
  * the look-up's, setting the look-up's uniforms on `program` (made current). */
 void sl_lr_bezier_bind(const sl_lr_bezier_gpu *gpu, unsigned program);

@@ -5,9 +5,11 @@
 # with the adaptive step (k-d forest look-up, auto), Marschner-Lobb of degree
 # 3 in MIP with a uniform step through a 4^3 k-d forest, a vector field by
 # its magnitude through one k-d tree, and that field with 24 streamlines
-# traced on the GPU and drawn as tubes inside it (these four with "jitter":
-# false, the midpoint lattice they were made with), and the graded sphere at
-# uniform step 1 with the default per-pixel jitter (sphere_jitter). The
+# traced on the GPU and drawn as tubes inside it, and with 20 traced by RKF5
+# in double over the volume's own k-d tree blocks, depth map checked too
+# (vector_streamlines_double) (these five with "jitter": false, the midpoint
+# lattice they were made with), and the graded sphere at uniform step 1 with
+# the default per-pixel jitter (sphere_jitter). The
 # look-up paths matter: llvmpipe drew
 # a line of wrong rays through the tree look-ups' unbounded loops (fixed in
 # lr_lookup.glsl); these goldens hold the fixed images. The numerical checks
@@ -18,5 +20,5 @@
 # --update, look at the new goldens, and say so in the commit.
 sl_add_render_test(NAME lr_volume.goldens COMMAND ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-regress>|${CMAKE_CURRENT_SOURCE_DIR}/lr_volume/goldens|--out|${SL_RENDER_OUT}/lr_volume_goldens|--jobs|2|--junit|${SL_RENDER_OUT}/lr_volume_goldens.xml"
-  "-DOUT1=5 cases, 5 passed, 0 failed, 0 errors"
+  "-DOUT1=6 cases, 6 passed, 0 failed, 0 errors"
   ${SL_STEPS})

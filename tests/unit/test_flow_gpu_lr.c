@@ -38,6 +38,9 @@
  * step, and accept/reject decisions then part (counts differ by a few
  * samples on 7 of 18 lines). Fixed steps and the step control itself are
  * the CPU's (test_flow_gpu: double adaptive bit for bit on one field).
+ * Borrowed blocks (sl_flow_gpu_create_lr: a k-d tree look-up, uploaded in
+ * float, the double copies added later) trace the same lines bit for bit in
+ * every precision; mixed before the double copies is refused.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -192,6 +195,68 @@ static void check_adaptive(const sl_flow_field *f, sl_flow_gpu *g, const double 
     sl_flow_result_free(&ref);
 }
 
+/* The lines of two traces are the same bit for bit. */
+static int same_lines(const sl_flow_result *a, const sl_flow_result *b)
+{
+    if (a->line_count != b->line_count)
+        return 0;
+    for (size_t j = 0; j < a->line_count; j++) {
+        const sl_flow_line *p = &a->lines[j], *q = &b->lines[j];
+        if (p->count != q->count || p->stop != q->stop ||
+            (p->count && (memcmp(p->t, q->t, p->count * sizeof *p->t) != 0 ||
+                          memcmp(p->x, q->x, 3 * p->count * sizeof *p->x) != 0 ||
+                          memcmp(p->v, q->v, 3 * p->count * sizeof *p->v) != 0)))
+            return 0;
+    }
+    return 1;
+}
+
+/* Borrowed blocks (sl_flow_gpu_create_lr, as lr_volume shares its own):
+ * blocks with another look-up (one k-d tree) uploaded in float only trace
+ * single precision exactly as the flow's own blocks; mixed is refused until
+ * sl_lr_bezier_upload_double adds the double copies, then mixed and double
+ * equal the own blocks' traces bit for bit too. */
+static void check_borrowed(const sl_lr_volume *lr, const sl_flow_field *f, sl_flow_gpu *own, const double *seeds,
+                           size_t n, const char *model)
+{
+    sl_err err = {0};
+    sl_lr_bezier bz;
+    sl_lr_bezier_gpu blocks;
+    if (sl_lr_bezier_build(lr, SL_LR_LOOKUP_KDTREE, 0, &bz, &err) != SL_OK) {
+        SL_CHECK_MSG(0, "%s: blocks: %s", model, err.message);
+        return;
+    }
+    sl_flow_gpu *g = NULL;
+    sl_status st = sl_lr_bezier_upload(&bz, 0, &blocks, &err);
+    if (st == SL_OK)
+        st = sl_flow_gpu_create_lr(f, &bz, &blocks, &g, &err);
+    SL_CHECK_MSG(st == SL_OK, "%s: borrowed blocks: %s", model, err.message);
+    const sl_flow_options o = {.solver = SL_FLOW_RK4, .t_max = 2.0, .max_samples = 400,
+                               .mode = SL_FLOW_STEP_HEURISTIC, .step = 0.5};
+    for (int p = SL_FLOW_SINGLE; g && p <= SL_FLOW_DOUBLE; p++) {
+        sl_flow_result a = {0}, b = {0};
+        if (p == SL_FLOW_MIXED) {
+            st = sl_flow_gpu_trace(g, seeds, n, &o, SL_FLOW_MIXED, &b, NULL, &err);
+            SL_CHECK_MSG(st == SL_ERR_INVALID && strstr(err.message, "double"),
+                         "%s: mixed on float-only borrowed blocks: %d %s", model, st, err.message);
+            sl_flow_result_free(&b);
+            SL_CHECK_MSG(sl_lr_bezier_upload_double(&bz, &blocks, &err) == SL_OK, "%s", err.message);
+        }
+        SL_CHECK(sl_flow_gpu_trace(own, seeds, n, &o, (sl_flow_precision)p, &a, NULL, &err) == SL_OK);
+        st = sl_flow_gpu_trace(g, seeds, n, &o, (sl_flow_precision)p, &b, NULL, &err);
+        SL_CHECK_MSG(st == SL_OK, "%s: borrowed %s: %s", model, sl_flow_precision_name((sl_flow_precision)p),
+                     err.message);
+        SL_CHECK_MSG(st != SL_OK || same_lines(&a, &b), "%s: borrowed k-d tree blocks trace other %s lines", model,
+                     sl_flow_precision_name((sl_flow_precision)p));
+        sl_flow_result_free(&a);
+        sl_flow_result_free(&b);
+    }
+    printf("%s: borrowed blocks (k-d tree) trace the own blocks' lines bit for bit\n", model);
+    sl_flow_gpu_destroy(g);
+    sl_lr_bezier_release(&blocks);
+    sl_lr_bezier_free(&bz);
+}
+
 int main(void)
 {
     sl_gpu *gpu = NULL;
@@ -260,6 +325,8 @@ int main(void)
         }
         if (g)
             check_adaptive(&f, g, seeds, n, names[refine], refine == 2);
+        if (g)
+            check_borrowed(&lr, &f, g, seeds, n, names[refine]);
         sl_flow_gpu_destroy(g);
         sl_lr_free(&lr);
     }

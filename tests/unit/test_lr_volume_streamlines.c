@@ -7,9 +7,12 @@
  *    in double (sl_flow_trace: no GL, no tubes code) from the same seeds,
  *    within a bound stated below; and the tubes cover the CPU lines'
  *    projections. Single-sample and 4x MSAA (the nearest-sample depth copy);
- *  - the cache: the first frame traces (rebuild_ms > 0); a camera move, a
- *    transfer function, the tube radius or colormap do not trace again
- *    (rebuild_ms == 0); seeds, solver and precision do;
+ *  - the cache: the first frame prepares and its prepare traces (the
+ *    prepare's "streamlines" and "streamline_trace_ms" extras); MSAA, a
+ *    camera move, a transfer function, the tube radius or colormap neither
+ *    prepare nor trace (rebuild_ms == 0); seeds, solver, precision and
+ *    t_max re-prepare and trace; turned on after the prepare, the next
+ *    frame traces once (rebuild_ms > 0) and the frames after it do not;
  *  - composition: with a visible volume, pixels no tube covers are the
  *    image without streamlines (blending over the cleared background:
  *    within 1 level of rounding), tube pixels keep a depth at least the
@@ -18,7 +21,9 @@
  *  - the rays end at the tubes: in a medium of constant colour and opacity
  *    each tube pixel is c A + (1 - A) tube with A = 1 - (1 - alpha)^(L / s_min)
  *    over the length L in front of the tube (CPU, double), within 3 levels;
- *  - a scalar volume with streamlines on is refused with a sentence.
+ *  - a scalar volume with streamlines on is refused with a sentence, by the
+ *    prepare or, turned on later, by the render (the volume then renders
+ *    again with them off).
  * Single-threaded (render thread).
  */
 #include <cjson/cJSON.h>
@@ -100,6 +105,28 @@ static sl_status scene_render(scene *s, const char *params, int samples, sl_fram
     if (rc == SL_OK)
         rc = sl_pipeline_render(s->pipe, &s->view, samples, st, err);
     return rc;
+}
+
+/* The prepare's extra `name` of a frame that prepared; -1 when absent. */
+static double prepare_extra(const sl_frame_stats *st, const char *name)
+{
+    for (int i = 0; st->prepared && i < st->prepare.extra_count; i++)
+        if (strcmp(st->prepare.extra[i].name, name) == 0)
+            return st->prepare.extra[i].value;
+    return -1.0;
+}
+
+/* A frame that prepared and traced in its prepare (no render-time trace). */
+static int traced_in_prepare(const sl_frame_stats *st)
+{
+    return st->prepared == 1 && prepare_extra(st, "streamlines") > 0 && prepare_extra(st, "streamline_trace_ms") > 0 &&
+           st->render.rebuild_ms == 0;
+}
+
+/* A frame that neither prepared nor traced. */
+static int cached(const sl_frame_stats *st)
+{
+    return st->prepared == 0 && st->render.rebuild_ms == 0;
 }
 
 /* Distance from p to the polyline x[0..n-1] (double). */
@@ -227,26 +254,74 @@ static void test_geometry_and_cache(void)
     sl_frame_stats st;
     sl_err err = {0};
     SL_CHECK_MSG(scene_render(&s, params, 1, &st, &err) == SL_OK, "%s", err.message);
-    SL_CHECK_MSG(st.render.rebuild_ms > 0, "the first frame did not trace");
+    SL_CHECK_MSG(traced_in_prepare(&st), "the first frame did not trace in its prepare (prepared %d, rebuild %g ms)",
+                 st.prepared, st.render.rebuild_ms);
+    printf("prepare: %.0f lines, %.0f samples, trace %.1f ms (dispatch %.1f ms), tubes prepare %.1f ms\n",
+           prepare_extra(&st, "streamlines"), prepare_extra(&st, "streamline_samples"),
+           prepare_extra(&st, "streamline_trace_ms"), prepare_extra(&st, "streamline_compute_ms"),
+           prepare_extra(&st, "streamline_tubes_ms"));
     check_geometry(&s, &ref, radius, 0, "single-sample");
     SL_CHECK_MSG(scene_render(&s, params, 4, &st, &err) == SL_OK, "%s", err.message);
-    SL_CHECK_MSG(st.render.rebuild_ms == 0, "4x MSAA traced again");
+    SL_CHECK_MSG(cached(&st), "4x MSAA prepared or traced again");
     check_geometry(&s, &ref, radius, 1, "4x MSAA");
-    /* Frame-level changes that do not shape the lines: no new trace. */
+    /* Frame-level changes that do not shape the lines: no prepare, no trace. */
     scene_view(&s, 70, -10);
-    SL_CHECK(scene_render(&s, params, 1, &st, &err) == SL_OK && st.render.rebuild_ms == 0);
+    SL_CHECK(scene_render(&s, params, 1, &st, &err) == SL_OK);
+    SL_CHECK_MSG(cached(&st), "a camera move prepared or traced again");
     check_geometry(&s, &ref, radius, 0, "another camera");
     snprintf(params, sizeof params,
              "{\"streamlines\":true,\"transfer_function\":[[0,0,0,0,0],[1,1,1,1,0.2]],%s,%s,\"tube_radius\":%g,"
              "\"tube_colormap\":\"magma\"}", SEEDS, TRACE, 2 * RADIUS_FRACTION);
-    SL_CHECK(scene_render(&s, params, 1, &st, &err) == SL_OK && st.render.rebuild_ms == 0);
-    /* What shapes the lines: traced again (the change comes last in the
-     * object, and sl_params_apply_json applies members in order). */
-    const char *changes[] = {"\"seed_count\":13", "\"solver\":\"rk3\"", "\"precision\":\"double\"", "\"t_max\":1.4"};
+    SL_CHECK(scene_render(&s, params, 1, &st, &err) == SL_OK);
+    SL_CHECK_MSG(cached(&st), "the transfer function, radius or colormap prepared or traced again");
+    /* What shapes the lines: another prepared state, traced (the change
+     * comes last in the object, and sl_params_apply_json applies members in
+     * order). */
+    const char *changes[] = {"\"seed_count\":13", "\"seed_min\":[0.25,0.3,0.3]", "\"solver\":\"rk3\"",
+                             "\"precision\":\"double\"", "\"t_max\":1.4"};
     for (size_t k = 0; k < sizeof changes / sizeof changes[0]; k++) {
         snprintf(params, sizeof params, "{\"streamlines\":true,%s,%s,%s,%s}", CLEAR_TF, SEEDS, TRACE, changes[k]);
         SL_CHECK_MSG(scene_render(&s, params, 1, &st, &err) == SL_OK, "%s: %s", changes[k], err.message);
-        SL_CHECK_MSG(st.render.rebuild_ms > 0, "%s did not trace again", changes[k]);
+        SL_CHECK_MSG(traced_in_prepare(&st), "%s did not re-prepare and trace", changes[k]);
+        scene_view(&s, 30, 20);
+        SL_CHECK(scene_render(&s, params, 1, &st, &err) == SL_OK);
+        SL_CHECK_MSG(cached(&st), "after %s a camera move prepared or traced again", changes[k]);
+    }
+    sl_flow_result_free(&ref);
+    sl_pipeline_destroy(s.pipe);
+}
+
+/* `streamlines` is FRAME level: off at the prepare, then on: that frame
+ * traces (rebuild_ms), the next frames and turning it off and on again do
+ * not; the lines are those of a prepare with it on (same geometry check). */
+static void test_turned_on_later(void)
+{
+    scene s;
+    if (!scene_open(&s, VECTOR_FIELD) || !scene_view(&s, 30, 20))
+        return;
+    sl_flow_result ref = {0};
+    if (!reference_lines(s.ds, &ref))
+        return;
+    char off[512], on[512];
+    snprintf(off, sizeof off, "{\"streamlines\":false,%s,%s,%s,\"tube_radius\":%g}", CLEAR_TF, SEEDS, TRACE,
+             RADIUS_FRACTION);
+    snprintf(on, sizeof on, "{\"streamlines\":true,%s,%s,%s,\"tube_radius\":%g}", CLEAR_TF, SEEDS, TRACE,
+             RADIUS_FRACTION);
+    sl_frame_stats st;
+    sl_err err = {0};
+    SL_CHECK(scene_render(&s, off, 1, &st, &err) == SL_OK);
+    SL_CHECK_MSG(st.prepared == 1 && prepare_extra(&st, "streamlines") < 0 && st.render.rebuild_ms == 0,
+                 "off: prepared %d, streamlines extra %g, rebuild %g ms", st.prepared,
+                 prepare_extra(&st, "streamlines"), st.render.rebuild_ms);
+    SL_CHECK(scene_render(&s, on, 1, &st, &err) == SL_OK);
+    SL_CHECK_MSG(st.prepared == 0 && st.render.rebuild_ms > 0, "turned on: prepared %d, rebuild %g ms", st.prepared,
+                 st.render.rebuild_ms);
+    check_geometry(&s, &ref, RADIUS_FRACTION * domain_diagonal(s.ds), 0, "turned on later");
+    const char *again[] = {on, off, on};
+    for (int k = 0; k < 3; k++) {
+        SL_CHECK(scene_render(&s, again[k], 1, &st, &err) == SL_OK);
+        SL_CHECK_MSG(cached(&st), "frame %d after turning on: prepared %d, rebuild %g ms", k, st.prepared,
+                     st.render.rebuild_ms);
     }
     sl_flow_result_free(&ref);
     sl_pipeline_destroy(s.pipe);
@@ -375,10 +450,18 @@ static void test_scalar_refused(void)
         return;
     sl_frame_stats st;
     sl_err err = {0};
+    /* On at the prepare: the prepare refuses; then off: the volume renders. */
     sl_status rc = scene_render(&s, "{\"streamlines\":true}", 1, &st, &err);
     SL_CHECK_MSG(rc == SL_ERR_INVALID && strstr(err.message, "vector"), "scalar + streamlines: %d %s", rc,
                  err.message);
-    SL_CHECK(scene_render(&s, "{\"streamlines\":false}", 1, &st, &err) == SL_OK);
+    printf("scalar + streamlines: %s\n", err.message);
+    SL_CHECK(scene_render(&s, "{\"streamlines\":false}", 1, &st, &err) == SL_OK && st.prepared == 1);
+    /* Turned on after the prepare (FRAME level): that render refuses, the state stays, off renders again. */
+    memset(&err, 0, sizeof err);
+    rc = scene_render(&s, "{\"streamlines\":true,\"tube_radius\":0.01}", 1, &st, &err);
+    SL_CHECK_MSG(rc == SL_ERR_INVALID && strstr(err.message, "vector"), "scalar, streamlines turned on: %d %s", rc,
+                 err.message);
+    SL_CHECK(scene_render(&s, "{\"streamlines\":false}", 1, &st, &err) == SL_OK && st.prepared == 0);
     sl_pipeline_destroy(s.pipe);
 }
 
@@ -390,6 +473,7 @@ int main(void)
         return 1;
     }
     test_geometry_and_cache();
+    test_turned_on_later();
     test_composition();
     test_constant_medium();
     test_scalar_refused();
