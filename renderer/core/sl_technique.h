@@ -44,7 +44,12 @@ typedef struct sl_render_stats {
     double rebuild_ms;       /* derived data this render built because a FRAME-level
                                 parameter asked for it (lr_volume: the streamline trace and
                                 its tubes when `streamlines` is turned on after the
-                                prepare); 0 when the technique's cache held */
+                                prepare; tubes on Embree: the BVH after a radius
+                                change); 0 when the technique's cache held */
+    const char *backend;     /* techniques with two executions (core/sl_backend.h): the
+                                one that drew this frame, "gl" or the CPU one's name
+                                ("embree"); NULL for techniques with one */
+    int threads;             /* CPU executions: worker threads that drew this frame */
 } sl_render_stats;
 
 /* A named number of a technique's own ("set0.particles"), so callers can

@@ -15,17 +15,28 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../line_style/sl_line_shade.h"
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_backend.h"
 #include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
 #include "../lines/sl_line_gpu.h"
+#include "tubes_embree.h"
 #include "tubes_nodes.h"
 
 static const char *const root_methods[] = {"bisection", "illinois", "newton", NULL};
 static const char *const tangent_modes[] = {"auto", "catmull_rom", "data_exact", NULL};
 static const char *const prepass_modes[] = {"auto", "on", "off", NULL};
+static const char *const backend_choices[] = {"auto", "gl", "embree", NULL};
+
+/* The CPU execution for the backend rule (core/sl_backend.h). */
+static sl_backend_cpu embree_backend(void)
+{
+    return (sl_backend_cpu){.name = "embree", .built = sl_tubes_embree_available(),
+                            .missing = "Debian libembree-dev (Embree 3.13)"};
+}
 enum { SL_TUBES_PREPASS_AUTO, SL_TUBES_PREPASS_ON, SL_TUBES_PREPASS_OFF };
 
 /* auto: the pre-pass pays where tubes hide each other. Estimated depth
@@ -42,8 +53,10 @@ enum { SL_TUBES_PREPASS_AUTO, SL_TUBES_PREPASS_ON, SL_TUBES_PREPASS_OFF };
 static const sl_param_def tubes_params[] = {
     SL_LINE_STYLE_PARAMS,
     SL_LINE_STYLE_RADIUS_ATTRIBUTE_PARAM,
+    SL_BACKEND_PARAM(backend_choices, "embree"),
     {"iterations", SL_PARAM_INT, 1, 64, {20}, NULL, "",
-     "steps of every root search (the accuracy knob)", SL_INVALIDATE_FRAME},
+     "steps of every root search (the accuracy knob; gl only: embree's hits are refined in double)",
+     SL_INVALIDATE_FRAME},
     {"root_method", SL_PARAM_ENUM, 0, 0, {1}, root_methods, "",
      "root search: bisection (as in the paper), Illinois regula falsi (default), or newton (safeguarded Newton; "
      "Illinois in a smoothing variable for the entry-distance derivative): fewer steps for the same error",
@@ -78,6 +91,10 @@ typedef struct tubes_state {
     GLuint empty_vao;            /* no attributes: the pulling and full-screen passes */
     size_t gpu_bytes;
     sl_prepare_stats prep;      /* node build (CPU) and upload times */
+    sl_backend backend;         /* the execution chosen at prepare */
+    sl_tubes_embree *embree;    /* backend embree: the device and BVH */
+    sl_host_frame host;         /* backend embree: the traced frame on its way into the target */
+    int embree_attribute;       /* backend embree: the colour attribute in nodes.color (-2: none yet) */
 } tubes_state;
 
 static void tubes_release(void *opaque)
@@ -100,13 +117,42 @@ static void tubes_release(void *opaque)
     sl_line_colors_deinit(&s->colors);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     if (s->query) glDeleteQueries(1, &s->query);
+    sl_tubes_embree_destroy(s->embree);
+    sl_host_frame_deinit(&s->host);
     sl_tubes_nodes_deinit(&s->nodes);
     free(s);
 }
 
+/* Backend embree: the device and the BVH of the prepared radii; the nodes stay on the CPU
+ * (colour scalars are refilled when the attribute changes). */
+static sl_status prepare_embree(tubes_state *s, const sl_params *params, sl_err *err)
+{
+    sl_status st = sl_tubes_embree_create(&s->nodes, &s->embree, err);
+    if (st != SL_OK)
+        return st;
+    sl_line_style style;
+    sl_line_style_read(params, s->dataset, &style);
+    double build_ms;
+    if ((st = sl_tubes_embree_ensure(s->embree, style.radius, style.radius_scale, &build_ms, err)) != SL_OK)
+        return st;
+    sl_tubes_embree_stats es;
+    sl_tubes_embree_stats_get(s->embree, &es);
+    s->prep.preprocess_ms += build_ms;
+    sl_prepare_stats_add(&s->prep, "embree.bvh_ms", build_ms);
+    sl_prepare_stats_add(&s->prep, "embree.bvh_bytes", es.bvh_bytes);
+    sl_prepare_stats_add(&s->prep, "embree.curves", (double)es.curves);
+    sl_prepare_stats_add(&s->prep, "embree.spheres", (double)es.spheres);
+    sl_prepare_stats_add(&s->prep, "embree.exact", (double)es.exact);
+    free(s->nodes.geometry); /* the device keeps its own copy */
+    s->nodes.geometry = NULL;
+    free(s->nodes.segments);
+    s->nodes.segments = NULL;
+    s->embree_attribute = -2;
+    return SL_OK;
+}
+
 static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out, sl_err *err)
 {
-    (void)gpu;
     *out = NULL;
     if (ds->kind != SL_DATASET_LINES)
         return sl_err_set(err, SL_ERR_INVALID, "tubes renders line sets, not %s datasets", sl_dataset_kind_name(ds->kind));
@@ -131,6 +177,16 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
         s->length_radius_sum += chord * 0.5 * fabs((double)a[3] + b[3]);
     }
     s->prep.preprocess_ms = sl_clock_ms() - t_build;
+    const sl_backend_cpu cpu = embree_backend();
+    if ((st = sl_backend_decide("tubes", sl_params_choice(params, "backend"), sl_gpu_is_software(gpu), &cpu,
+                                &s->backend, err)) != SL_OK)
+        goto fail;
+    if (s->backend == SL_BACKEND_CPU) {
+        if ((st = prepare_embree(s, params, err)) != SL_OK)
+            goto fail;
+        *out = s;
+        return SL_OK;
+    }
     const struct { const char *label, *vertex, *fragment; GLuint *program; int boxes; } programs[] = {
         {"tubes", "tubes/tubes.vert.glsl", "tubes/tubes.frag.glsl", &s->program, 1},
         {"tubes_silhouette", "tubes/tubes.vert.glsl", "tubes/tubes_silhouette.frag.glsl", &s->program_silhouette, 1},
@@ -319,6 +375,29 @@ static int use_prepass(const tubes_state *s, const sl_view *view, const sl_param
     return 2.0 * weighted / (SL_PI * bound * bound) >= SL_TUBES_PREPASS_MIN_DEPTH_COMPLEXITY;
 }
 
+/* Backend embree: trace on the CPU, then the frame's colour and depth into the target. */
+static sl_status render_embree(tubes_state *s, const sl_view *view, const sl_params *params,
+                               const sl_line_style *style, sl_render_stats *stats, sl_err *err)
+{
+    if (s->embree_attribute != style->attribute) {
+        sl_tubes_nodes_set_color(&s->dataset->lines, style->attribute, &s->nodes);
+        s->embree_attribute = style->attribute;
+    }
+    if (sl_params_bool(params, "silhouette_only")) /* a GL experiment: nothing to draw */
+        return SL_OK;
+    sl_line_shader shader;
+    sl_line_shader_init(&shader, style, view);
+    sl_status st = sl_tubes_embree_render(s->embree, view, &shader, s->nodes.color, style->radius,
+                                          style->radius_scale, &s->host, &stats->rebuild_ms, err);
+    if (st != SL_OK)
+        return st;
+    sl_tubes_embree_stats es;
+    sl_tubes_embree_stats_get(s->embree, &es);
+    stats->primitives = es.rays;
+    stats->threads = es.threads;
+    return sl_host_frame_draw(&s->host, err);
+}
+
 static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
                               sl_render_stats *stats, sl_err *err)
 {
@@ -329,6 +408,11 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
+    const sl_backend_cpu cpu = embree_backend();
+    stats->backend = sl_backend_name(s->backend, &cpu);
+    stats->culled = 0.0;
+    if (s->backend == SL_BACKEND_CPU)
+        return render_embree(s, view, params, &style, stats, err);
     if (sl_line_colors_update(&s->colors, &s->dataset->lines, &style)) {
         sl_tubes_nodes_set_color(&s->dataset->lines, style.attribute, &s->nodes);
         if (s->nodes.node_count)
@@ -337,7 +421,6 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
     }
     sl_camera_ubo_update(&s->camera_ubo, view);
     sl_line_colors_bind(&s->colors, 0, 0);
-    stats->culled = 0.0;
     int silhouette_only = sl_params_bool(params, "silhouette_only");
     if (!silhouette_only && use_prepass(s, view, params, &style))
         return render_with_prepass(s, view, params, &style, stats, err);
@@ -354,7 +437,7 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
 static size_t tubes_gpu_bytes(const void *opaque)
 {
     const tubes_state *s = opaque;
-    return s ? s->gpu_bytes + (size_t)s->nearest_w * (size_t)s->nearest_h * 4u : 0;
+    return s ? s->gpu_bytes + (size_t)s->nearest_w * (size_t)s->nearest_h * 4u + sl_host_frame_gpu_bytes(&s->host) : 0;
 }
 
 static void tubes_prepare_stats(const void *opaque, sl_prepare_stats *out)

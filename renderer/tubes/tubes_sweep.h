@@ -1,0 +1,46 @@
+/* tubes_sweep.h — one quadratic sub-segment of `tubes` as a sphere sweep, in double, for
+ * the CPU execution (tubes_embree.c): the union of the spheres centred on the quadratic
+ * Bézier c(t) with radius |r(t)|, t in [0, 1].
+ *
+ * Along a ray o + l d (d unit) the entry into the sphere of parameter t is
+ *   l(t) = d.q(t) - sqrt(r(t)^2 - |q(t)|^2 + (d.q(t))^2),   q = c - o,
+ * where the root is real; the sweep's entry is the smallest local minimum of l(t) over
+ * [0, 1] (the ends count) that lies at or beyond l_min. Rays that start inside a sphere
+ * see the next entry beyond l_min, the GL path's rule (tubes_intersect.glsl).
+ * sl_tubes_sweep_intersect finds it by sampling t densely enough that consecutive
+ * spheres overlap (up to 512 samples) and golden-section search around every sampled
+ * minimum; sl_tubes_sweep_refine polishes a float hit near a known t by Newton steps on
+ * l'(t). sl_tubes_sweep_regular says whether the sweep has the smooth envelope that
+ * Embree's round curves assume. Pure functions, any thread.
+ */
+#ifndef SL_TUBES_SWEEP_H
+#define SL_TUBES_SWEEP_H
+
+/* Controls of one sub-segment, relative to the dataset origin. */
+typedef struct sl_tubes_sweep {
+    double b[3][3];  /* Bézier controls of the centre */
+    double r[3];     /* Bézier controls of the radius (sign ignored: |r|) */
+} sl_tubes_sweep;
+
+/* 1 when r > 0 on [0, 1], |c'(t)| >= 1.05 |r'(t)| everywhere and r(t) times the
+ * curvature stays below 0.5: the sweep's surface is the envelope of its spheres with
+ * no fold, which Embree's round curves (with end spheres) reproduce. */
+int sl_tubes_sweep_regular(const sl_tubes_sweep *s);
+
+/* The nearest entry at l >= l_min and l < l_max: 1 and *l, *t; 0 when none. */
+int sl_tubes_sweep_intersect(const sl_tubes_sweep *s, const double o[3], const double d[3], double l_min,
+                             double l_max, double *l, double *t);
+
+/* Residual of a hit at distance l on the sphere of parameter t: max of |dist - r| and the
+ * offset along the tangent from the contact circle, over r (0 = exact). */
+double sl_tubes_sweep_residual(const sl_tubes_sweep *s, const double o[3], const double d[3], double l, double t);
+
+/* Newton on l'(t) from t0 (at most 6 steps, clamped to [0, 1]): 1 with the refined *l, *t
+ * when it converged to an entry >= l_min; 0 leaves them unchanged. */
+int sl_tubes_sweep_refine(const sl_tubes_sweep *s, const double o[3], const double d[3], double l_min, double t0,
+                          double *l, double *t);
+
+/* Centre and radius at t. */
+void sl_tubes_sweep_eval(const sl_tubes_sweep *s, double t, double c[3], double *r);
+
+#endif
