@@ -587,6 +587,10 @@ char *sl_msg_progress_text(const sl_msg_progress *p)
         cJSON_AddBoolToObject(o, "ok", p->ok);
         cJSON_AddNumberToObject(o, "render_ms", round(p->render_ms * 10) / 10);
         cJSON_AddNumberToObject(o, "frame", p->frame);
+        if (p->backend && p->backend[0])
+            cJSON_AddStringToObject(o, "backend", p->backend);
+        else
+            cJSON_AddNullToObject(o, "backend");
     }
     return print_and_free(o);
 }

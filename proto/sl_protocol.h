@@ -235,6 +235,8 @@ typedef struct sl_msg_progress {
     double render_ms;              /* done: the first frame's render + readback */
     uint32_t frame;                /* done: id of that frame, 0 when none */
     int ok;                        /* done: 1 a frame was published; 0 failed or superseded */
+    const char *backend;           /* done: the execution that drew it ("gl", "embree"; core/sl_backend.h),
+                                      NULL (sent as null) for techniques with one */
 } sl_msg_progress;
 
 char *sl_msg_progress_text(const sl_msg_progress *p);

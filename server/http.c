@@ -20,6 +20,16 @@
 
 static const double bucket_ms[SL_HIST_BUCKETS - 1] = {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 5000};
 
+const char *const sl_metric_backend_names[SL_METRIC_BACKENDS] = {"gl", "embree", "cpu", "single"};
+
+int sl_metric_backend_index(const char *backend)
+{
+    for (int i = 0; backend && i < SL_METRIC_BACKENDS - 1; i++)
+        if (!strcmp(backend, sl_metric_backend_names[i]))
+            return i;
+    return SL_METRIC_BACKENDS - 1;
+}
+
 void sl_histogram_add(sl_histogram *h, double ms)
 {
     for (int i = 0; i < SL_HIST_BUCKETS - 1; i++)
@@ -124,6 +134,11 @@ char *sl_http_metrics(sl_server *srv)
     for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
         append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,
                counters[i].name, counters[i].name, (unsigned long long)counters[i].v);
+    append(&b, &len, &cap, "# HELP sightline_frames_by_backend_total Frames rendered, by the execution that drew "
+           "them (gl, embree, cpu; single: techniques with one).\n# TYPE sightline_frames_by_backend_total counter\n");
+    for (int i = 0; i < SL_METRIC_BACKENDS; i++)
+        append(&b, &len, &cap, "sightline_frames_by_backend_total{backend=\"%s\"} %llu\n", sl_metric_backend_names[i],
+               (unsigned long long)m.frames_by_backend[i]);
     append(&b, &len, &cap, "# HELP sightline_node_info This node's id (--node-id), in the label.\n"
            "# TYPE sightline_node_info gauge\nsightline_node_info{node=\"%s\"} 1\n", srv->cfg.node_id);
     append(&b, &len, &cap, "# HELP sightline_draining 1 while the node drains (SIGTERM): no new sessions.\n"

@@ -24,7 +24,7 @@ static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double 
     sl_msg_progress m = {.stage = stage, .round = r->id, .version = r->version, .dataset = r->dataset,
                          .technique = r->technique, .fraction = -1, .elapsed_ms = sl_clock_ms() - r->t0_ms,
                          .load_ms = r->load_ms, .prepare_ms = r->prepare_ms, .render_ms = render_ms,
-                         .frame = frame, .ok = ok};
+                         .frame = frame, .ok = ok, .backend = r->backend};
     char *text = sl_msg_progress_text(&m), *old = NULL;
     if (!text)
         return;

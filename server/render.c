@@ -420,7 +420,8 @@ static int ready_scene(render_ctx *ctx, sl_session *s, const sl_session_state *s
  * the session's size) with interactive or still quality; *render_ms is the
  * render call's wall time (no prepare: ready_scene ran it). */
 static sl_status render_view(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
-                             double scale, int *w_out, int *h_out, double *render_ms, sl_err *err)
+                             double scale, int *w_out, int *h_out, double *render_ms, const char **backend,
+                             sl_err *err)
 {
     sl_status rc;
     sl_pipeline *pl = s->prepared->pipeline;
@@ -447,6 +448,8 @@ static sl_status render_view(render_ctx *ctx, sl_session *s, const sl_session_st
     sl_frame_stats stats;
     if ((rc = sl_pipeline_render(pl, &view, 1, &stats, err)) != SL_OK)
         return rc;
+    *backend = stats.render.backend;
+    snprintf(s->round.backend, sizeof s->round.backend, "%s", stats.render.backend ? stats.render.backend : "");
     if ((rc = ensure_rgba(ctx, w, h, err)) != SL_OK)
         return rc;
     *w_out = w;
@@ -479,7 +482,8 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     if (!ready_scene(ctx, s, st))
         return;
     double t0 = sl_clock_ms();
-    if (render_view(ctx, s, st, interactive, scale, &w, &h, &render_ms, &err) != SL_OK) {
+    const char *backend = NULL;
+    if (render_view(ctx, s, st, interactive, scale, &w, &h, &render_ms, &backend, &err) != SL_OK) {
         sl_progress_end(ctx->srv, s, 0, 0, 0);
         report_error(ctx->srv, s, st, &err);
         return;
@@ -517,6 +521,7 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     }
     srv->last_frame_ms = render_ms + encode_ms;
     srv->metrics.frames_rendered++;
+    srv->metrics.frames_by_backend[sl_metric_backend_index(backend)]++;
     sl_histogram_add(&srv->metrics.render_ms, render_ms);
     sl_histogram_add(&srv->metrics.encode_ms, encode_ms);
     pthread_mutex_unlock(&srv->lock);
@@ -544,7 +549,8 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
             requeue_snapshots(srv, s, ids, n);
         return;
     }
-    if (render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &err) == SL_OK) {
+    const char *backend = NULL;
+    if (render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &backend, &err) == SL_OK) {
         sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 1);
         if (sl_encoder_png(ctx->rgba, w, h, &f, &encode_ms, &err) == SL_OK) {
             f->header.state_version = st->version;
@@ -638,8 +644,9 @@ static void do_record(render_ctx *ctx, sl_session *s, sl_record_job *j, int canc
     }
     int w = 0, h = 0;
     double render_ms = 0;
+    const char *backend = NULL;
     if (rc == SL_OK)
-        rc = render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &err);
+        rc = render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &backend, &err);
     if (rc == SL_OK) {
         sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 1);
         test_delay(srv, st, w, h);

@@ -209,6 +209,7 @@ typedef struct sl_progress_round {
     char dataset[SL_PROTO_NAME_MAX], technique[SL_PROTO_NAME_MAX];
     double t0_ms, load_ms, prepare_ms;
     int stage;                       /* the last stage posted, -1 none */
+    char backend[16];                /* the execution of the newest frame ("" = one only) */
 } sl_progress_round;
 
 typedef struct sl_client sl_client;
@@ -341,6 +342,12 @@ typedef struct sl_histogram {
     uint64_t total;
 } sl_histogram;
 
+/* Executions a frame can come from (core/sl_backend.h): "gl", "embree", "cpu", and
+ * "single" for techniques with one. */
+#define SL_METRIC_BACKENDS 4
+extern const char *const sl_metric_backend_names[SL_METRIC_BACKENDS];
+int sl_metric_backend_index(const char *backend); /* NULL or unknown: the "single" slot */
+
 typedef struct sl_metrics {                  /* [lock] */
     uint64_t frames_rendered, frames_sent, frames_dropped, frames_failed;
     uint64_t snapshots, bytes_sent, messages_in, errors_sent;
@@ -348,7 +355,10 @@ typedef struct sl_metrics {                  /* [lock] */
     uint64_t refused_full, refused_address, pending_evicted;  /* WebSocket admission */
     sl_histogram render_ms, encode_ms;
     sl_histogram load_ms, prepare_ms;        /* dataset loads (loader thread), technique prepares */
+    uint64_t frames_by_backend[SL_METRIC_BACKENDS]; /* frames rendered, by sl_metric_backend_names */
 } sl_metrics;
+
+
 
 void sl_histogram_add(sl_histogram *h, double ms);
 

@@ -7,7 +7,9 @@
  * dims, voxel type, spacing, value range and NaN voxels (volumes), degree,
  * dim, element / basis / mesh-rectangle counts, refinement levels, domain and
  * the sampled value range (LR-spline volumes), and load_ms.
- * `sightline-info --list` prints the generator families and built-ins.
+ * `sightline-info --list` prints the generator families and built-ins;
+ * `sightline-info --backends` opens the GL device and prints, for every technique
+ * with two executions (core/sl_backend.h), which one `backend = auto` picks here.
  * Does no loading or generating itself. Single-threaded.
  * Exit status: 0 success; 1 usage error (usage on stderr); 2 bad input, with
  * the reason on stderr and {"error", "status"} on stdout.
@@ -18,7 +20,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/sl_backend.h"
+#include "core/sl_technique.h"
 #include "data/sl_dataset.h"
+#include "gpu/sl_gpu.h"
 #include "data/sl_generate.h"
 #include "data/sl_load.h"
 #include "lrspline/sl_lr.h"
@@ -31,6 +36,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: sightline-info FILE | GENERATOR-JSON | BUILTIN-NAME\n"
             "       sightline-info --list\n"
+            "       sightline-info --backends\n"
             "Prints a JSON description of the dataset (counts, bounds, attributes,\n"
             "volume dims and value range; LR-spline degree, elements, basis functions,\n"
             "refinement levels, domain and sampled value range; load_ms).\n"
@@ -162,6 +168,41 @@ static cJSON *list_json(void)
     return root;
 }
 
+/* {"renderer", "software", "techniques": {name: {"auto", "built": [...], "missing"}}} or NULL. */
+static cJSON *backends_json(void)
+{
+    sl_gpu *gpu = NULL;
+    sl_err err = {0};
+    if (sl_gpu_create(&(sl_gpu_desc){.quiet = 1}, &gpu, &err) != SL_OK) {
+        fprintf(stderr, "sightline-info: %s\n", err.message);
+        return NULL;
+    }
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "renderer", sl_gpu_renderer(gpu));
+    cJSON_AddBoolToObject(o, "software", sl_gpu_is_software(gpu));
+    cJSON *list = cJSON_AddObjectToObject(o, "techniques");
+    int count = 0;
+    const sl_technique *const *all = sl_technique_list(&count);
+    for (int i = 0; i < count; i++) {
+        if (!all[i]->backend_cpu)
+            continue;
+        sl_backend_cpu cpu;
+        all[i]->backend_cpu(&cpu);
+        sl_backend pick = SL_BACKEND_GL;
+        sl_backend_decide(all[i]->name, SL_BACKEND_AUTO, sl_gpu_is_software(gpu), &cpu, &pick, NULL);
+        cJSON *t = cJSON_AddObjectToObject(list, all[i]->name);
+        cJSON_AddStringToObject(t, "auto", sl_backend_name(pick, &cpu));
+        cJSON *built = cJSON_AddArrayToObject(t, "built");
+        cJSON_AddItemToArray(built, cJSON_CreateString("gl"));
+        if (cpu.built)
+            cJSON_AddItemToArray(built, cJSON_CreateString(cpu.name));
+        else
+            cJSON_AddStringToObject(t, "missing", cpu.missing);
+    }
+    sl_gpu_destroy(gpu);
+    return o;
+}
+
 static int print_json(cJSON *root)
 {
     char *text = root ? cJSON_Print(root) : NULL;
@@ -184,6 +225,10 @@ int main(int argc, char **argv)
     const char *input = argv[1];
     if (strcmp(input, "--list") == 0)
         return print_json(list_json());
+    if (strcmp(input, "--backends") == 0) {
+        cJSON *b = backends_json();
+        return b ? print_json(b) : 3;
+    }
     if (input[0] == '-') {
         fprintf(stderr, "sightline-info: unknown option %s\n", input);
         usage(stderr);

@@ -378,6 +378,12 @@ static int write_stats(const options *o, const sl_scene *scene, const sl_gpu *gp
         cJSON_AddNumberToObject(extra, name, e->value);
     }
     cJSON_AddNumberToObject(s, "gpu_bytes", (double)last->gpu_bytes);
+    /* Techniques with two executions: the one that drew the frames (core/sl_backend.h). */
+    if (last->render.backend)
+        cJSON_AddStringToObject(s, "backend", last->render.backend);
+    else
+        cJSON_AddNullToObject(s, "backend");
+    cJSON_AddNumberToObject(s, "threads", last->render.threads);
     cJSON_AddNumberToObject(s, "primitives", last->render.primitives);
     cJSON_AddNumberToObject(s, "culled", last->render.culled);
     cJSON_AddNumberToObject(s, "dropped", last->render.dropped);

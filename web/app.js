@@ -217,6 +217,7 @@ function updateStatus() {
     parts.push(`${f.width}×${f.height} ${(f.bytes / 1024).toFixed(1)} KiB`);
     const t = progress.timings;
     if (t) parts.push(`load ${t.loadMs.toFixed(0)} ms`, `prepare ${t.prepareMs.toFixed(0)} ms`);
+    if (t && t.backend) parts.push(`backend ${t.backend}`);
     parts.push(`render ${f.renderMs.toFixed(1)} ms`, `encode ${f.encodeMs.toFixed(1)} ms`);
     parts.push(f.interactive ? `interactive ${scaleLabel(f.width)}` : 'still');
     parts.push(`frame ${f.frameId}`);

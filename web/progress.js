@@ -2,7 +2,7 @@
 // prepares a technique or renders the first frame of it (`progress` messages,
 // proto/PROTOCOL.md). A fraction fills the bar; without one (null) the bar
 // runs indeterminate. `done` hides it and keeps the round's load and prepare
-// times for the status line. It draws nothing else and sends nothing.
+// times and the backend that drew it (gl, embree: techniques with two executions) for the status line. It draws nothing else and sends nothing.
 
 const LABELS = { loading: 'Loading', preparing: 'Preparing', first_frame: 'Rendering the first frame of' };
 
@@ -22,7 +22,7 @@ export class ProgressOverlay {
   update(msg) {
     if (msg.stage === 'done') {
       if (msg.round === this.round || this.stage === null) this.hide();
-      this.timings = { loadMs: msg.load_ms, prepareMs: msg.prepare_ms };
+      this.timings = { loadMs: msg.load_ms, prepareMs: msg.prepare_ms, backend: msg.backend || null };
       return;
     }
     this.round = msg.round;

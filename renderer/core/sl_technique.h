@@ -25,6 +25,7 @@
 
 #include <stddef.h>
 
+#include "sl_backend.h"
 #include "sl_camera.h"
 #include "sl_params.h"
 #include "sl_status.h"
@@ -99,6 +100,10 @@ typedef struct sl_technique {
      * SL_ERR_IO (cannot write) or SL_ERR_NOMEM; the message names the file. */
     const char *export_ext;
     sl_status (*export_geometry)(void *state, const sl_params *params, const char *path, sl_err *err);
+
+    /* Techniques with two executions (core/sl_backend.h; their schema has `backend`):
+     * describes the CPU one, so callers can say what `auto` picks here. NULL: one only. */
+    void (*backend_cpu)(sl_backend_cpu *out);
 } sl_technique;
 
 /* The registry (sl_registry.c holds the one table). */

@@ -45,6 +45,8 @@ static const char *const step_mode_names[] = {"adaptive", "uniform", NULL};
 /* In the order of sl_lr_lookup_kind. */
 static const char *const lookup_names[] = {"auto", "texture", "octree", "kdtree", "kdforest", NULL};
 
+static const char *const tube_backends[] = {"auto", "gl", "embree", NULL};
+
 static const sl_param_def lr_volume_params[] = {
     {"transfer_function", SL_PARAM_TRANSFER, 0, 0, {0, SL_TF_AUTO_OPACITY, 0}, NULL, "data",
      "colour and opacity per data value (vectors: of the magnitude), as volume_dvr's; opacity per smallest "
@@ -102,6 +104,9 @@ static const sl_param_def lr_volume_params[] = {
      "(1/300 of the lines' bounding radius)", SL_INVALIDATE_FRAME},
     {"tube_colormap", SL_PARAM_ENUM, 0, 0, {0}, sl_colormap_names, "", "streamlines: colormap of the speed",
      SL_INVALIDATE_FRAME},
+    {"tube_backend", SL_PARAM_ENUM, 0, 0, {0}, tube_backends, "",
+     "streamlines: the tubes' backend (auto: embree on a software GL device, gl on a GPU; gl; embree)",
+     SL_INVALIDATE_PREPARED},
 };
 
 enum { UNIT_TF = 1, UNIT_OPAQUE_DEPTH = 2, ROWS_BINDING = 5, VISIBLE_BINDING = 4, PROXY_N = 48, MAX_STEPS = 1 << 16 };

@@ -116,7 +116,7 @@ static sl_status trace_lines(lrv_streamlines *s, const sl_params *p, sl_flow_res
 
 /* The lines of r as a line set and the tubes prepared on it (nothing to
  * draw when no line has two samples: seeds where the field is zero). */
-static sl_status make_tubes(lrv_streamlines *s, const sl_flow_result *r, sl_err *err)
+static sl_status make_tubes(lrv_streamlines *s, const sl_flow_result *r, const sl_params *params, sl_err *err)
 {
     size_t samples = 0, lines = 0;
     for (size_t i = 0; i < r->line_count; i++) {
@@ -141,6 +141,9 @@ static sl_status make_tubes(lrv_streamlines *s, const sl_flow_result *r, sl_err 
         return sl_err_set(err, SL_ERR_INVALID, "streamlines: the line set has no speed attribute");
     if ((st = sl_params_set_numbers(&s->tube_params, "attribute", &speed, 1, err)) != SL_OK)
         return st;
+    if ((st = sl_params_set_choice(&s->tube_params, "backend", sl_params_choice_name(params, "tube_backend"), err)) !=
+        SL_OK)
+        return st;
     double t0 = sl_clock_ms();
     st = s->tubes->prepare(s->gpu, s->lines, &s->tube_params, &s->tubes_state, err);
     s->tubes_ms = sl_clock_ms() - t0;
@@ -154,7 +157,7 @@ sl_status lrv_streamlines_trace(lrv_streamlines *s, const sl_params *params, sl_
     sl_flow_result r = {0};
     sl_status st = trace_lines(s, params, &r, err);
     if (st == SL_OK)
-        st = make_tubes(s, &r, err);
+        st = make_tubes(s, &r, params, err);
     sl_flow_result_free(&r);
     if (st != SL_OK) {
         drop_lines(s);

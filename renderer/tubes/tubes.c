@@ -32,9 +32,9 @@ static const char *const prepass_modes[] = {"auto", "on", "off", NULL};
 static const char *const backend_choices[] = {"auto", "gl", "embree", NULL};
 
 /* The CPU execution for the backend rule (core/sl_backend.h). */
-static sl_backend_cpu embree_backend(void)
+static void tubes_backend_cpu(sl_backend_cpu *out)
 {
-    return (sl_backend_cpu){.name = "embree", .built = sl_tubes_embree_available(),
+    *out = (sl_backend_cpu){.name = "embree", .built = sl_tubes_embree_available(),
                             .missing = "Debian libembree-dev (Embree 3.13)"};
 }
 enum { SL_TUBES_PREPASS_AUTO, SL_TUBES_PREPASS_ON, SL_TUBES_PREPASS_OFF };
@@ -148,7 +148,7 @@ static sl_status prepare_embree(tubes_state *s, const sl_params *params, sl_err 
     free(s->nodes.segments);
     s->nodes.segments = NULL;
     s->embree_attribute = -2;
-    return SL_OK;
+    return sl_gl_check_errors("tubes (embree): preparing", err); /* the frame still goes through GL */
 }
 
 static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_params *params, void **out, sl_err *err)
@@ -177,7 +177,8 @@ static sl_status tubes_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl_param
         s->length_radius_sum += chord * 0.5 * fabs((double)a[3] + b[3]);
     }
     s->prep.preprocess_ms = sl_clock_ms() - t_build;
-    const sl_backend_cpu cpu = embree_backend();
+    sl_backend_cpu cpu;
+    tubes_backend_cpu(&cpu);
     if ((st = sl_backend_decide("tubes", sl_params_choice(params, "backend"), sl_gpu_is_software(gpu), &cpu,
                                 &s->backend, err)) != SL_OK)
         goto fail;
@@ -389,13 +390,18 @@ static sl_status render_embree(tubes_state *s, const sl_view *view, const sl_par
     sl_line_shader_init(&shader, style, view);
     sl_status st = sl_tubes_embree_render(s->embree, view, &shader, s->nodes.color, style->radius,
                                           style->radius_scale, &s->host, &stats->rebuild_ms, err);
-    if (st != SL_OK)
+    if (st != SL_OK) {
+        if (!strstr(err->message, "tubes"))
+            sl_err_prefix(err, "tubes (embree)");
         return st;
+    }
     sl_tubes_embree_stats es;
     sl_tubes_embree_stats_get(s->embree, &es);
     stats->primitives = es.rays;
     stats->threads = es.threads;
-    return sl_host_frame_draw(&s->host, err);
+    if ((st = sl_host_frame_draw(&s->host, err)) != SL_OK)
+        sl_err_prefix(err, "tubes (embree)");
+    return st;
 }
 
 static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params *params, sl_target *target,
@@ -408,7 +414,8 @@ static sl_status tubes_render(void *opaque, const sl_view *view, const sl_params
         return st;
     sl_line_style style;
     sl_line_style_read(params, s->dataset, &style);
-    const sl_backend_cpu cpu = embree_backend();
+    sl_backend_cpu cpu;
+    tubes_backend_cpu(&cpu);
     stats->backend = sl_backend_name(s->backend, &cpu);
     stats->culled = 0.0;
     if (s->backend == SL_BACKEND_CPU)
@@ -457,4 +464,5 @@ const sl_technique sl_tubes_technique = {
     .release = tubes_release,
     .gpu_bytes = tubes_gpu_bytes,
     .prepare_stats = tubes_prepare_stats,
+    .backend_cpu = tubes_backend_cpu,
 };

@@ -14,15 +14,30 @@
 #include "tubes_sweep.h"
 
 #define TILE 16
-#define MAX_RETRACE 8
+#define MAX_RETRACE 16
 #define RESIDUAL_OK 1e-4
+/* Curves and caps go to Embree this much fatter: its float intersector drops rays that graze a
+ * tube within ~1e-5 r (random set seed 2: a rim ray 3e-5 r inside the sweep missed, so the
+ * tube behind showed, 8.8 r deeper). Every candidate is then decided on the true sweep in
+ * double: refined, or, where the ray misses it, traced on. */
+#define INFLATE 1.02
+#define END_T 1e-7 /* a hit parameter this close to a piece's end is at the end */
 
 /* One quadratic sub-segment and where its colour comes from. */
 typedef struct piece {
     sl_tubes_sweep sweep;    /* double copy of the float controls */
     uint32_t node0, node1;   /* the Hermite segment's nodes */
     uint8_t half;            /* 0: node0 .. joint, 1: joint .. node1 */
+    float t0, t1;            /* the part of the half it covers: half parameter = t0 + t (t1 - t0) */
+    int64_t prev, next;      /* the piece this one continues at t = 0 / t = 1 (C1 joint), -1: none */
+    uint8_t exact;           /* a user primitive (else an Embree curve) */
 } piece;
+
+/* Embree's round-curve intersector lost hits inside a sub-segment that turned by 80 degrees
+ * (random set seed 2, 8.8 r of depth): each half is cut (exactly, by de Casteljau) into
+ * pieces that turn by at most this much, at most MAX_CUTS of them. */
+#define MAX_TURN_DEG 30.0
+#define MAX_CUTS 1
 
 /* A sphere point at an envelope's end: the node and the piece end that shades it. */
 typedef struct cap {
@@ -40,7 +55,10 @@ struct sl_tubes_embree {
     uint32_t *segments;
     int has_radii;
     float built_radius;      /* radius (no data radii) or radius_scale the BVH holds; NAN: none */
-    piece *pieces;           /* 2 per segment */
+    piece *pieces;           /* >= 2 per segment: each half cut into pieces by its turn */
+    size_t piece_count, piece_capacity;
+    uint32_t *half_first;    /* per half (2 per segment): its first piece; its pieces follow */
+    uint8_t *half_cuts;      /* per half: its piece count */
     uint32_t *curve_piece, *exact_piece; /* primID -> piece */
     cap *caps;
     size_t curves, cap_count, exact;
@@ -85,11 +103,10 @@ sl_status sl_tubes_embree_create(const sl_tubes_nodes *nodes, sl_tubes_embree **
     size_t nn = e->node_count ? e->node_count : 1, ns = e->segment_count ? e->segment_count : 1;
     e->geometry = malloc(nn * SL_TUBES_NODE_FLOATS * sizeof(float));
     e->segments = malloc(ns * 2 * sizeof(uint32_t));
-    e->pieces = malloc(ns * 2 * sizeof(piece));
-    e->curve_piece = malloc(ns * 2 * sizeof(uint32_t));
-    e->exact_piece = malloc(ns * 2 * sizeof(uint32_t));
-    e->caps = malloc(ns * 4 * sizeof(cap));
-    if (!e->geometry || !e->segments || !e->pieces || !e->curve_piece || !e->exact_piece || !e->caps) {
+    e->half_first = malloc(ns * 2 * sizeof(uint32_t));
+    e->half_cuts = malloc(ns * 2);
+    e->caps = malloc(ns * 2 * sizeof(cap));
+    if (!e->geometry || !e->segments || !e->half_first || !e->half_cuts || !e->caps) {
         size_t segments = e->segment_count;
         sl_tubes_embree_destroy(e);
         return sl_err_set(err, SL_ERR_NOMEM, "tubes (embree): out of memory for %zu segments", segments);
@@ -134,6 +151,8 @@ void sl_tubes_embree_destroy(sl_tubes_embree *e)
     free(e->geometry);
     free(e->segments);
     free(e->pieces);
+    free(e->half_first);
+    free(e->half_cuts);
     free(e->curve_piece);
     free(e->exact_piece);
     free(e->caps);
@@ -183,7 +202,7 @@ static void exact_bounds(const struct RTCBoundsFunctionArguments *args)
 {
     const sl_tubes_embree *e = args->geometryUserPtr;
     const sl_tubes_sweep *s = &e->pieces[e->exact_piece[args->primID]].sweep;
-    double rmax = fmax(fabs(s->r[0]), fmax(fabs(s->r[1]), fabs(s->r[2])));
+    double rmax = INFLATE * fmax(fabs(s->r[0]), fmax(fabs(s->r[1]), fabs(s->r[2])));
     double lo[3], hi[3];
     for (int c = 0; c < 3; c++) {
         lo[c] = fmin(s->b[0][c], fmin(s->b[1][c], s->b[2][c])) - rmax;
@@ -211,14 +230,23 @@ static void exact_intersect(const struct RTCIntersectFunctionNArguments *args)
     float *ray = (float *)args->rayhit;
     float *hit = ray + RAY_FLOATS * n;
     uint32_t *hit_u = (uint32_t *)hit;
-    const sl_tubes_sweep *s = &e->pieces[e->exact_piece[args->primID]].sweep;
+    /* the candidate test on the inflated sweep (as the curves): the float ray may miss a rim
+     * that the double ray hits; resolve_pixel decides on the true sweep in double */
+    sl_tubes_sweep fat = e->pieces[e->exact_piece[args->primID]].sweep;
+    for (int k = 0; k < 3; k++)
+        fat.r[k] *= INFLATE;
+    const sl_tubes_sweep *s = &fat;
     for (unsigned i = 0; i < n; i++) {
         if (!args->valid[i])
             continue;
         double o[3] = {ray[(RAY_ORG + 0) * n + i], ray[(RAY_ORG + 1) * n + i], ray[(RAY_ORG + 2) * n + i]};
         double d[3] = {ray[(RAY_DIR + 0) * n + i], ray[(RAY_DIR + 1) * n + i], ray[(RAY_DIR + 2) * n + i]};
         double l, t;
-        if (!sl_tubes_sweep_intersect(s, o, d, ray[RAY_TNEAR * n + i], ray[RAY_TFAR * n + i], &l, &t))
+        /* after a retrace from tnear, the inflated entry may lie before tnear while the true one
+         * lies beyond: then the true one is the candidate */
+        if (!sl_tubes_sweep_intersect(s, o, d, ray[RAY_TNEAR * n + i], ray[RAY_TFAR * n + i], &l, &t) &&
+            !sl_tubes_sweep_intersect(&e->pieces[e->exact_piece[args->primID]].sweep, o, d, ray[RAY_TNEAR * n + i],
+                                      ray[RAY_TFAR * n + i], &l, &t))
             continue;
         double c[3], r;
         sl_tubes_sweep_eval(s, t, c, &r);
@@ -233,6 +261,138 @@ static void exact_intersect(const struct RTCIntersectFunctionNArguments *args)
     }
 }
 
+/* A segment end for linking: its node's position and tangent, bit for bit. */
+typedef struct joint_key {
+    float key[6];
+    int64_t piece;  /* the piece that ends (is_start 0, t = 1) or starts (1, t = 0) there */
+    int is_start;
+} joint_key;
+
+static int compare_joint(const void *pa, const void *pb)
+{
+    const joint_key *a = pa, *b = pb;
+    int c = memcmp(a->key, b->key, sizeof a->key);
+    return c ? c : a->is_start - b->is_start;
+}
+
+static size_t first_of(const sl_tubes_embree *e, size_t half) { return e->half_first[half]; }
+static size_t last_of(const sl_tubes_embree *e, size_t half) { return e->half_first[half] + e->half_cuts[half] - 1u; }
+
+static void link(sl_tubes_embree *e, size_t from, size_t to)
+{
+    e->pieces[from].next = (int64_t)to;
+    e->pieces[to].prev = (int64_t)from;
+}
+
+/* prev / next: the pieces of a half in turn, the two halves of a segment, and across a joint
+ * where exactly one segment ends and one starts at the same position with the same tangent (a
+ * polyline's vertex, or explicit Hermite segments that share a node; each segment has its own
+ * node copies then). */
+static void link_pieces(sl_tubes_embree *e)
+{
+    for (size_t p = 0; p < e->piece_count; p++)
+        e->pieces[p].prev = e->pieces[p].next = -1;
+    for (size_t h = 0; h < 2 * e->segment_count; h++)
+        for (size_t p = first_of(e, h); p < last_of(e, h); p++)
+            link(e, p, p + 1);
+    for (size_t k = 0; k < e->segment_count; k++)
+        link(e, last_of(e, 2 * k), first_of(e, 2 * k + 1));
+    joint_key *keys = e->segment_count ? malloc(2 * e->segment_count * sizeof *keys) : NULL;
+    if (!keys)
+        return; /* no links across joints: refinement stays within segments */
+    for (size_t k = 0; k < e->segment_count; k++)
+        for (int end = 0; end < 2; end++) {
+            const float *n = e->geometry + (size_t)e->segments[2 * k + (size_t)end] * SL_TUBES_NODE_FLOATS;
+            joint_key *j = &keys[2 * k + (size_t)end];
+            memset(j, 0, sizeof *j);
+            for (int c = 0; c < 3; c++) {
+                j->key[c] = n[c] + 0.0f; /* -0 as +0 */
+                j->key[3 + c] = n[4 + c] + 0.0f;
+            }
+            j->is_start = end == 0;
+            j->piece = (int64_t)(end == 0 ? first_of(e, 2 * k) : last_of(e, 2 * k + 1));
+        }
+    size_t count = 2 * e->segment_count;
+    qsort(keys, count, sizeof *keys, compare_joint);
+    for (size_t i = 0; i < count;) {
+        size_t j = i + 1;
+        while (j < count && !memcmp(keys[j].key, keys[i].key, sizeof keys[i].key))
+            j++;
+        if (j - i == 2 && !keys[i].is_start && keys[i + 1].is_start)
+            link(e, (size_t)keys[i].piece, (size_t)keys[i + 1].piece);
+        i = j;
+    }
+    free(keys);
+}
+
+/* Degrees the quadratic's tangent turns over [0, 1] (it turns in one plane, monotonically). */
+static double turn_degrees(const sl_tubes_sweep *s)
+{
+    double a[3], b[3], aa = 0.0, bb = 0.0, ab = 0.0;
+    for (int c = 0; c < 3; c++) {
+        a[c] = s->b[1][c] - s->b[0][c];
+        b[c] = s->b[2][c] - s->b[1][c];
+        aa += a[c] * a[c];
+        bb += b[c] * b[c];
+        ab += a[c] * b[c];
+    }
+    if (!(aa > 0.0) || !(bb > 0.0))
+        return 180.0;
+    double cosine = fmin(fmax(ab / sqrt(aa * bb), -1.0), 1.0);
+    return acos(cosine) * 180.0 / 3.14159265358979323846;
+}
+
+/* The part [a, b] of a quadratic as a quadratic: c(a), c(a) + (b - a) c'(a) / 2, c(b). */
+static void cut_sweep(const sl_tubes_sweep *s, double a, double b, sl_tubes_sweep *out)
+{
+    double ua = 1.0 - a, ub = 1.0 - b;
+    for (int c = 0; c < 3; c++) {
+        double q[3] = {s->b[0][c], s->b[1][c], s->b[2][c]};
+        double ca = ua * ua * q[0] + 2.0 * ua * a * q[1] + a * a * q[2];
+        double cb = ub * ub * q[0] + 2.0 * ub * b * q[1] + b * b * q[2];
+        double da = 2.0 * (ua * (q[1] - q[0]) + a * (q[2] - q[1]));
+        out->b[0][c] = ca;
+        out->b[1][c] = ca + 0.5 * (b - a) * da;
+        out->b[2][c] = cb;
+    }
+    const double *r = s->r;
+    double ra = ua * ua * r[0] + 2.0 * ua * a * r[1] + a * a * r[2];
+    double rb = ub * ub * r[0] + 2.0 * ub * b * r[1] + b * b * r[2];
+    double dra = 2.0 * (ua * (r[1] - r[0]) + a * (r[2] - r[1]));
+    out->r[0] = ra;
+    out->r[1] = ra + 0.5 * (b - a) * dra;
+    out->r[2] = rb;
+}
+
+/* Appends the pieces of one half (cut by its turn) to e->pieces. */
+static sl_status add_half(sl_tubes_embree *e, const piece *half, size_t index)
+{
+    int cuts = (int)ceil(turn_degrees(&half->sweep) / MAX_TURN_DEG);
+    cuts = cuts < 1 ? 1 : (cuts > MAX_CUTS ? MAX_CUTS : cuts);
+    if (e->piece_count + (size_t)cuts > e->piece_capacity) {
+        size_t cap = e->piece_capacity ? 2 * e->piece_capacity : 2 * e->segment_count + 16;
+        while (cap < e->piece_count + (size_t)cuts)
+            cap *= 2;
+        piece *grown = realloc(e->pieces, cap * sizeof *grown);
+        if (!grown)
+            return SL_ERR_NOMEM;
+        e->pieces = grown;
+        e->piece_capacity = cap;
+    }
+    e->half_first[index] = (uint32_t)e->piece_count;
+    e->half_cuts[index] = (uint8_t)cuts;
+    for (int i = 0; i < cuts; i++) {
+        piece *p = &e->pieces[e->piece_count++];
+        *p = *half;
+        p->exact = 0;
+        p->t0 = (float)i / (float)cuts;
+        p->t1 = (float)(i + 1) / (float)cuts;
+        if (cuts > 1)
+            cut_sweep(&half->sweep, (double)i / cuts, (double)(i + 1) / cuts, &p->sweep);
+    }
+    return SL_OK;
+}
+
 /* (Re)builds the scene for radius_or_scale. */
 static sl_status build(sl_tubes_embree *e, float radius_or_scale, sl_err *err)
 {
@@ -241,66 +401,76 @@ static sl_status build(sl_tubes_embree *e, float radius_or_scale, sl_err *err)
         rtcReleaseScene(e->scene);
     e->scene = NULL;
     e->curves = e->cap_count = e->exact = 0;
-    uint8_t *uses = calloc(e->node_count ? e->node_count : 1, 1); /* regular piece ends at the node, saturating */
-    uint32_t *use_piece = malloc((e->node_count ? e->node_count : 1) * sizeof(uint32_t));
-    uint8_t *use_end = malloc(e->node_count ? e->node_count : 1);
-    if (!uses || !use_piece || !use_end) {
-        free(uses);
-        free(use_piece);
-        free(use_end);
-        return sl_err_set(err, SL_ERR_NOMEM, "tubes (embree): out of memory");
-    }
+    e->piece_count = 0;
     for (size_t k = 0; k < e->segment_count; k++) {
-        split_segment(e, k, radius_or_scale, &e->pieces[2 * k]);
-        for (int h = 0; h < 2; h++) {
-            uint32_t p = (uint32_t)(2 * k + (size_t)h);
-            if (sl_tubes_sweep_regular(&e->pieces[p].sweep)) {
-                e->curve_piece[e->curves++] = p;
-                uint32_t node = h == 0 ? e->segments[2 * k] : e->segments[2 * k + 1];
-                if (uses[node] < 255)
-                    uses[node]++;
-                use_piece[node] = p;
-                use_end[node] = (uint8_t)h;
-            } else {
-                e->exact_piece[e->exact++] = p;
-            }
-        }
+        piece halves[2];
+        split_segment(e, k, radius_or_scale, halves);
+        for (int h = 0; h < 2; h++)
+            if (add_half(e, &halves[h], 2 * k + (size_t)h) != SL_OK)
+                return sl_err_set(err, SL_ERR_NOMEM, "tubes (embree): out of memory for %zu segments",
+                                  e->segment_count);
     }
-    /* Envelope ends: a node where not exactly two regular pieces meet (line end, bifurcation,
-     * one side exact), or where the two differ in tangent (a corner of duplicated nodes has two
-     * node indices, each used once). */
-    for (size_t node = 0; node < e->node_count; node++)
-        if (uses[node] == 1 || uses[node] > 2)
-            e->caps[e->cap_count++] = (cap){use_piece[node], use_end[node]};
-    free(uses);
-    free(use_piece);
-    free(use_end);
+    size_t np = e->piece_count ? e->piece_count : 1;
+    uint32_t *curve_piece = realloc(e->curve_piece, np * sizeof(uint32_t));
+    if (curve_piece)
+        e->curve_piece = curve_piece;
+    uint32_t *exact_piece = realloc(e->exact_piece, np * sizeof(uint32_t));
+    if (exact_piece)
+        e->exact_piece = exact_piece;
+    if (!curve_piece || !exact_piece)
+        return sl_err_set(err, SL_ERR_NOMEM, "tubes (embree): out of memory for %zu pieces", e->piece_count);
+    link_pieces(e);
+    /* Regular pieces go to Embree, except beside an exact one: Embree cuts a curve at the plane
+     * through its end, and an entry just past that plane belongs to no Embree primitive when
+     * the neighbour is exact (random set seed 1: 17 r of depth lost). */
+    uint8_t *regular = malloc(np);
+    if (!regular)
+        return sl_err_set(err, SL_ERR_NOMEM, "tubes (embree): out of memory for %zu pieces", e->piece_count);
+    for (size_t p = 0; p < e->piece_count; p++)
+        regular[p] = (uint8_t)sl_tubes_sweep_regular(&e->pieces[p].sweep);
+    for (size_t p = 0; p < e->piece_count; p++) {
+        const piece *q = &e->pieces[p];
+        int beside_exact = (q->prev >= 0 && !regular[q->prev]) || (q->next >= 0 && !regular[q->next]);
+        if (regular[p] && !beside_exact)
+            e->curve_piece[e->curves++] = (uint32_t)p;
+        else
+            e->exact_piece[e->exact++] = (uint32_t)p;
+        if (!regular[p] || beside_exact)
+            e->pieces[p].exact = 1;
+    }
+    free(regular);
+    /* Envelope ends: a regular piece's end that continues into no other piece (line end,
+     * bifurcation, corner); exact pieces hold their end spheres themselves. */
+    for (size_t k = 0; k < 2 * e->segment_count; k++) {
+        size_t p = (k & 1) ? last_of(e, k) : first_of(e, k);
+        int at_end = (int)(k & 1);
+        const piece *q = &e->pieces[p];
+        if ((at_end ? q->next : q->prev) < 0 && !q->exact)
+            e->caps[e->cap_count++] = (cap){(uint32_t)p, (uint8_t)at_end};
+    }
 
     e->scene = rtcNewScene(e->device);
     rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
     if (e->curves) {
-        RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE);
+        RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_ROUND_BEZIER_CURVE);
         float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-                                           2 * e->curves);
-        float *tg = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_TANGENT, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-                                            2 * e->curves);
+                                           4 * e->curves);
         uint32_t *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t),
                                                e->curves);
-        if (v && tg && ix) {
+        if (v && ix) {
             for (size_t k = 0; k < e->curves; k++) {
                 const sl_tubes_sweep *s = &e->pieces[e->curve_piece[k]].sweep;
-                /* the quadratic as a cubic Hermite: p(0), p(1), p'(0) = 2 (b1 - b0), p'(1) = 2 (b2 - b1) */
-                for (int c = 0; c < 3; c++) {
-                    v[8 * k + c] = (float)s->b[0][c];
-                    v[8 * k + 4 + c] = (float)s->b[2][c];
-                    tg[8 * k + c] = (float)(2.0 * (s->b[1][c] - s->b[0][c]));
-                    tg[8 * k + 4 + c] = (float)(2.0 * (s->b[2][c] - s->b[1][c]));
+                /* the quadratic as a cubic Bezier (degree elevation): b0, (b0 + 2 b1) / 3, (2 b1 + b2) / 3, b2,
+                 * the radius likewise */
+                for (int c = 0; c < 4; c++) {
+                    double w0 = c == 0 ? 1.0 : c == 1 ? 1.0 / 3.0 : 0.0;
+                    double w1 = c == 1 || c == 2 ? 2.0 / 3.0 : 0.0;
+                    double w2 = c == 3 ? 1.0 : c == 2 ? 1.0 / 3.0 : 0.0;
+                    for (int x = 0; x < 3; x++)
+                        v[16 * k + 4 * c + x] = (float)(w0 * s->b[0][x] + w1 * s->b[1][x] + w2 * s->b[2][x]);
+                    v[16 * k + 4 * c + 3] = (float)(INFLATE * (w0 * s->r[0] + w1 * s->r[1] + w2 * s->r[2]));
                 }
-                v[8 * k + 3] = (float)s->r[0];
-                v[8 * k + 7] = (float)s->r[2];
-                tg[8 * k + 3] = (float)(2.0 * (s->r[1] - s->r[0]));
-                tg[8 * k + 7] = (float)(2.0 * (s->r[2] - s->r[1]));
-                ix[k] = (uint32_t)(2 * k);
+                ix[k] = (uint32_t)(4 * k);
             }
         }
         rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
@@ -318,7 +488,7 @@ static sl_status build(sl_tubes_embree *e, float radius_or_scale, sl_err *err)
                 int end = e->caps[k].at_end ? 2 : 0;
                 for (int c = 0; c < 3; c++)
                     v[4 * k + c] = (float)s->b[end][c];
-                v[4 * k + 3] = (float)fabs(s->r[end]);
+                v[4 * k + 3] = (float)(INFLATE * fabs(s->r[end]));
             }
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(e->scene, g, GEOM_CAPS);
@@ -397,7 +567,54 @@ static const piece *hit_piece(const sl_tubes_embree *e, unsigned geom, unsigned 
     return &e->pieces[e->exact_piece[prim]];
 }
 
-static void trace_one(const sl_tubes_embree *e, const float org[3], const float dir[3], float tnear,
+/* Polishes a hit (l, t) on piece p in double: Newton on p from t when `newton` (else the exact
+ * search on p; NULL when the ray misses p's true sweep), then, while
+ * the hit sits at an end of its piece that joins another, Newton in that one from the joint
+ * (Embree's round curves end at a plane through the end point, so an entry whose parameter
+ * lies just past a joint can come back as the neighbour's end or an end sphere). Keeps the
+ * nearest entry found; returns its piece. */
+static const piece *refine_hit(const sl_tubes_embree *e, const piece *p, const double o[3], const double d[3],
+                               double l_min, int newton, double *l, double *t)
+{
+    double lr, tr;
+    if (newton) {
+        if (sl_tubes_sweep_refine(&p->sweep, o, d, l_min, *t, &lr, &tr) ||
+            sl_tubes_sweep_intersect(&p->sweep, o, d, l_min, INFINITY, &lr, &tr)) {
+            *l = lr;
+            *t = tr;
+        } else {
+            /* p's true sweep is missed: the candidate grazed its inflated one, or came from
+             * past a joint (Embree cuts a curve at its ends): the neighbours decide */
+            const piece *found = NULL;
+            for (int side = 0; side < 2; side++) {
+                int64_t other = side ? p->next : p->prev;
+                double lq, tq;
+                if (other >= 0 && sl_tubes_sweep_intersect(&e->pieces[other].sweep, o, d, l_min, INFINITY, &lq, &tq) &&
+                    (!found || lq < *l)) {
+                    found = &e->pieces[other];
+                    *l = lq;
+                    *t = tq;
+                }
+            }
+            return found;
+        }
+    }
+    for (int hop = 0; hop < 2; hop++) {
+        int64_t other = *t <= END_T ? p->prev : *t >= 1.0 - END_T ? p->next : -1;
+        if (other < 0)
+            break;
+        const piece *q = &e->pieces[other];
+        double lq, tq;
+        if (!sl_tubes_sweep_refine(&q->sweep, o, d, l_min, *t <= END_T ? 1.0 : 0.0, &lq, &tq) || !(lq < *l))
+            break;
+        p = q;
+        *l = lq;
+        *t = tq;
+    }
+    return p;
+}
+
+static void trace_one(const sl_tubes_embree *e, const float org[3], const float dir[3], float tnear, float tfar,
                       struct RTCRayHit *rh)
 {
     struct RTCIntersectContext ctx;
@@ -410,17 +627,56 @@ static void trace_one(const sl_tubes_embree *e, const float org[3], const float 
     rh->ray.dir_y = dir[1];
     rh->ray.dir_z = dir[2];
     rh->ray.tnear = tnear;
-    rh->ray.tfar = INFINITY;
+    rh->ray.tfar = tfar;
     rh->ray.mask = 0xffffffffu;
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(e->scene, &ctx, rh);
 }
 
-/* Resolves one pixel from its first hit: refines it in double, skips exits (rays that start
- * inside the sweep), shades. Writes the pixel's colour and depth (0: nothing). */
+/* A candidate from Embree decided on the true sweep in double: 1 with the entry (*l, *t) on
+ * *out; 0 when the ray leaves there (an exit: the ray started inside the sweep) or misses the
+ * true sweep (it grazed the inflated one). */
+static int decide_candidate(const sl_tubes_embree *e, const double o[3], const double d[3], double l_min,
+                            unsigned geom, unsigned prim, float u, float tfar, const piece **out, double *l,
+                            double *t, atomic_llong *refined)
+{
+    const piece *p = hit_piece(e, geom, prim, u, t);
+    *l = tfar;
+    if (geom == GEOM_CURVES) {
+        /* Embree's u and Ng are not reliable enough to tell an entry from an exit (measured:
+         * u 0.68 for an entry at 0.89): the piece's true sweep decides */
+        atomic_fetch_add_explicit(refined, 1, memory_order_relaxed);
+        p = refine_hit(e, p, o, d, l_min, 1, l, t);
+    } else if (geom == GEOM_CAPS) {
+        double c[3], r;
+        sl_tubes_sweep_eval(&p->sweep, *t, c, &r);
+        double q[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
+        double a = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
+        double disc = r * r - (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - a * a);
+        if (!(disc >= 0.0) || !(a - sqrt(disc) >= l_min))
+            return 0; /* missed, or an exit of a ray that starts inside the sphere */
+        *l = a - sqrt(disc);
+        p = refine_hit(e, p, o, d, l_min, 1, l, t);
+    } else {
+        /* the user primitive saw the float ray; at rims the depth is that sensitive to the
+         * ray's lateral position (measured: 0.036 r on the one-pixel tornado tubes), so the
+         * double ray decides again */
+        if (!sl_tubes_sweep_intersect(&p->sweep, o, d, l_min, INFINITY, l, t))
+            return 0;
+        if (*t <= END_T || *t >= 1.0 - END_T) /* an end sphere: the neighbour may hold a nearer entry */
+            p = refine_hit(e, p, o, d, l_min, 0, l, t);
+    }
+    *out = p;
+    return p != NULL;
+}
+
+/* Resolves one pixel from its first candidate: candidates come in the order of their inflated
+ * surfaces, and a primitive's inflated entry is never behind its true one, so taking them in
+ * turn until the next lies beyond the best true entry finds the nearest entry. Shades it into
+ * the frame (colour and depth; 0: nothing). */
 static void resolve_pixel(frame_job *job, int x, int y, const double d[3], unsigned geom, unsigned prim, float u,
-                          float tfar, float ng[3])
+                          float tfar)
 {
     const sl_tubes_embree *e = job->e;
     size_t at = (size_t)(job->height - 1 - y) * (size_t)job->width + (size_t)x;
@@ -428,68 +684,49 @@ static void resolve_pixel(frame_job *job, int x, int y, const double d[3], unsig
     double l_min = job->near_plane / fmax(df, 1e-30);
     const float org[3] = {(float)job->eye[0], (float)job->eye[1], (float)job->eye[2]};
     const float dir[3] = {(float)d[0], (float)d[1], (float)d[2]};
-    for (int round = 0; round <= MAX_RETRACE && geom != RTC_INVALID_GEOMETRY_ID; round++) {
-        double t, l = tfar;
-        const piece *p = hit_piece(e, geom, prim, u, &t);
-        int entry = 1;
-        if (geom == GEOM_CURVES) {
-            /* a back-facing hit is the exit of a ray that started inside the sweep */
-            entry = ng[0] * dir[0] + ng[1] * dir[1] + ng[2] * dir[2] < 0.0f;
-            if (entry && sl_tubes_sweep_residual(&p->sweep, job->eye, d, l, t) > RESIDUAL_OK) {
-                double lr, tr;
-                if (sl_tubes_sweep_refine(&p->sweep, job->eye, d, l_min, t, &lr, &tr)) {
-                    l = lr;
-                    t = tr;
-                    atomic_fetch_add_explicit(&job->refined, 1, memory_order_relaxed);
-                }
-            }
-        } else if (geom == GEOM_CAPS) {
-            /* the sphere's entry in double; an exit when the ray starts inside it */
-            double c[3], r;
-            sl_tubes_sweep_eval(&p->sweep, t, c, &r);
-            double q[3] = {c[0] - job->eye[0], c[1] - job->eye[1], c[2] - job->eye[2]};
-            double a = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
-            double disc = r * r - (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - a * a);
-            double le = a - sqrt(fmax(disc, 0.0));
-            entry = le >= l_min;
-            if (entry)
-                l = le;
+    const piece *best = NULL;
+    double best_l = INFINITY, best_t = 0.0;
+    for (int round = 0; round <= MAX_RETRACE && geom != RTC_INVALID_GEOMETRY_ID && tfar < best_l; round++) {
+        const piece *p;
+        double l, t;
+        int okc = decide_candidate(e, job->eye, d, l_min, geom, prim, u, tfar, &p, &l, &t, &job->refined);
+        if (okc && l < best_l) {
+            best = p;
+            best_l = l;
+            best_t = t;
         }
-        if (entry) {
-            double c[3], r;
-            sl_tubes_sweep_eval(&p->sweep, t, c, &r);
-            float n[3], v[3] = {-dir[0], -dir[1], -dir[2]};
-            double nl = 0.0;
-            for (int k = 0; k < 3; k++) {
-                n[k] = (float)(job->eye[k] + l * d[k] - c[k]);
-                nl += (double)n[k] * n[k];
-            }
-            nl = sqrt(nl);
-            for (int k = 0; k < 3; k++)
-                n[k] = nl > 0.0 ? (float)(n[k] / nl) : v[k];
-            const float *cs0 = job->colors + 2 * (size_t)p->node0, *cs1 = job->colors + 2 * (size_t)p->node1;
-            float ca2 = cs0[0] + cs0[1] / 3.0f, cb2 = cs1[0] - cs1[1] / 3.0f, cm = 0.5f * (ca2 + cb2);
-            float c0 = p->half ? cm : cs0[0], c1 = p->half ? cb2 : ca2, c2 = p->half ? cs1[0] : cm;
-            float ft = (float)t, fs = 1.0f - ft;
-            float scalar = fs * fs * c0 + 2.0f * fs * ft * c1 + ft * ft * c2;
-            sl_line_shader_color(job->shader, scalar, n, v, job->frame->rgba + 4 * at);
-            job->frame->depth[at] = (float)(job->near_plane / (l * df));
-            return;
-        }
-        /* an exit: trace on from just beyond it */
+        /* the next candidate beyond this one, nearer than the best entry */
         atomic_fetch_add_explicit(&job->retraced, 1, memory_order_relaxed);
         struct RTCRayHit rh;
-        trace_one(e, org, dir, nextafterf(tfar, INFINITY) * (1.0f + 1e-6f), &rh);
+        trace_one(e, org, dir, nextafterf(tfar, INFINITY), isfinite(best_l) ? (float)best_l : INFINITY, &rh);
         geom = rh.hit.geomID;
         prim = rh.hit.primID;
         u = rh.hit.u;
         tfar = rh.ray.tfar;
-        ng[0] = rh.hit.Ng_x;
-        ng[1] = rh.hit.Ng_y;
-        ng[2] = rh.hit.Ng_z;
     }
-    memset(job->frame->rgba + 4 * at, 0, 4);
-    job->frame->depth[at] = 0.0f;
+    if (!best) {
+        memset(job->frame->rgba + 4 * at, 0, 4);
+        job->frame->depth[at] = 0.0f;
+        return;
+    }
+    double c[3], r;
+    sl_tubes_sweep_eval(&best->sweep, best_t, c, &r);
+    float n[3], v[3] = {-dir[0], -dir[1], -dir[2]};
+    double nl = 0.0;
+    for (int k = 0; k < 3; k++) {
+        n[k] = (float)(job->eye[k] + best_l * d[k] - c[k]);
+        nl += (double)n[k] * n[k];
+    }
+    nl = sqrt(nl);
+    for (int k = 0; k < 3; k++)
+        n[k] = nl > 0.0 ? (float)(n[k] / nl) : v[k];
+    const float *cs0 = job->colors + 2 * (size_t)best->node0, *cs1 = job->colors + 2 * (size_t)best->node1;
+    float ca2 = cs0[0] + cs0[1] / 3.0f, cb2 = cs1[0] - cs1[1] / 3.0f, cm = 0.5f * (ca2 + cb2);
+    float c0 = best->half ? cm : cs0[0], c1 = best->half ? cb2 : ca2, c2 = best->half ? cs1[0] : cm;
+    float ft = best->t0 + (float)best_t * (best->t1 - best->t0), fs = 1.0f - ft;
+    float scalar = fs * fs * c0 + 2.0f * fs * ft * c1 + ft * ft * c2;
+    sl_line_shader_color(job->shader, scalar, n, v, job->frame->rgba + 4 * at);
+    job->frame->depth[at] = (float)(job->near_plane / (best_l * df));
 }
 
 typedef union packet16 {
@@ -548,9 +785,8 @@ static void trace_tile(void *opaque, int tile, int worker)
             for (int i = 0; i < n; i++) {
                 if (!valid[i])
                     continue;
-                float ng[3] = {hit[(HIT_NG + 0) * n + i], hit[(HIT_NG + 1) * n + i], hit[(HIT_NG + 2) * n + i]};
                 resolve_pixel(job, bx + i % bw, by + i / bw, dirs[i], hit_u[HIT_GEOM * n + i], hit_u[HIT_PRIM * n + i],
-                              hit[HIT_U * n + i], pk.f[RAY_TFAR * n + i], ng);
+                              hit[HIT_U * n + i], pk.f[RAY_TFAR * n + i]);
             }
         }
 }

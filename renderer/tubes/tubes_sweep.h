@@ -7,9 +7,10 @@
  * where the root is real; the sweep's entry is the smallest local minimum of l(t) over
  * [0, 1] (the ends count) that lies at or beyond l_min. Rays that start inside a sphere
  * see the next entry beyond l_min, the GL path's rule (tubes_intersect.glsl).
- * sl_tubes_sweep_intersect finds it by sampling t densely enough that consecutive
- * spheres overlap (up to 512 samples) and golden-section search around every sampled
- * minimum; sl_tubes_sweep_refine polishes a float hit near a known t by Newton steps on
+ * sl_tubes_sweep_intersect finds the parameter intervals where the ray meets the spheres
+ * exactly (the roots of the quartic r^2 - |q|^2 + (d.q)^2, isolated between the roots of
+ * its derivatives), samples l at 33 points of each and polishes every sampled minimum
+ * by golden-section search; sl_tubes_sweep_refine polishes a float hit near a known t by Newton steps on
  * l'(t). sl_tubes_sweep_regular says whether the sweep has the smooth envelope that
  * Embree's round curves assume. Pure functions, any thread.
  */
@@ -22,8 +23,8 @@ typedef struct sl_tubes_sweep {
     double r[3];     /* Bézier controls of the radius (sign ignored: |r|) */
 } sl_tubes_sweep;
 
-/* 1 when r > 0 on [0, 1], |c'(t)| >= 1.05 |r'(t)| everywhere and r(t) times the
- * curvature stays below 0.5: the sweep's surface is the envelope of its spheres with
+/* 1 when r > 0 on [0, 1], |c'(t)| >= 1.05 |r'(t)| everywhere and the largest radius times
+ * the largest curvature stays below 0.2 (tubes_sweep.c says why): the sweep's surface is the envelope of its spheres with
  * no fold, which Embree's round curves (with end spheres) reproduce. */
 int sl_tubes_sweep_regular(const sl_tubes_sweep *s);
 
@@ -35,8 +36,10 @@ int sl_tubes_sweep_intersect(const sl_tubes_sweep *s, const double o[3], const d
  * offset along the tangent from the contact circle, over r (0 = exact). */
 double sl_tubes_sweep_residual(const sl_tubes_sweep *s, const double o[3], const double d[3], double l, double t);
 
-/* Newton on l'(t) from t0 (at most 6 steps, clamped to [0, 1]): 1 with the refined *l, *t
- * when it converged to an entry >= l_min; 0 leaves them unchanged. */
+/* Newton on l'(t) from t0 (steps of at most 0.1, downhill where l is not convex, at most
+ * 16, clamped to [0, 1]): 1 with the refined *l, *t when it converged to a local minimum
+ * of l (an end counts where l rises into the piece) that is an entry >= l_min; else 0,
+ * leaving them unchanged. */
 int sl_tubes_sweep_refine(const sl_tubes_sweep *s, const double o[3], const double d[3], double l_min, double t0,
                           double *l, double *t);
 

@@ -4,6 +4,10 @@
 # not by the renderer's node builder) on random
 # and degenerate Hermite segment sets, through the pipeline (tubes-check) and
 # through `sightline-render --depth` + `sightline-diff`; golden images.
+# Backends: every test that says nothing runs on the default backend (auto: embree on
+# this machine's llvmpipe, gl on a GPU); tests of the GL path's own machinery (root
+# methods and iterations, the occlusion pre-pass, box proxies, frustum culling) say
+# --set params.backend=gl; backend.* compare the two executions.
 # Scenes and goldens live in tests/render/tubes/; chained commands run through
 # the step runner (SL_STEPS, tests/steps.cmake), and every test that
 # expects a failure names its exit code and its failure line.
@@ -39,9 +43,9 @@ foreach(seed 1 2 3)
     tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed ${seed})
 endforeach()
 tubes_render_test(accuracy.random_bisection
-  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 4 --set params.root_method=bisection)
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 4 --set params.root_method=bisection --set params.backend=gl)
 tubes_render_test(accuracy.random_bisection_stress
-  tubes-check --scene ${TUBES_DIR}/stress_big_radius.json --set params.root_method=bisection)
+  tubes-check --scene ${TUBES_DIR}/stress_big_radius.json --set params.root_method=bisection --set params.backend=gl)
 tubes_render_test(accuracy.random_no_culling
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 5 --set params.frustum_culling=false)
 tubes_render_test(accuracy.random_close
@@ -49,13 +53,13 @@ tubes_render_test(accuracy.random_close
 # Both proxies of a box: always one screen rectangle (every box "small") and
 # always the box faces of the paper; coverage is the fragment shader's either way.
 tubes_render_test(accuracy.random_all_rectangles
-  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=65536)
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=65536 --set params.backend=gl)
 tubes_render_test(accuracy.random_all_faces
-  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=0)
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 7 --set params.small_box_pixels=0 --set params.backend=gl)
 tubes_render_test(accuracy.stress_inside_rectangles
-  tubes-check --scene ${TUBES_DIR}/stress_inside.json --set params.small_box_pixels=65536)
+  tubes-check --scene ${TUBES_DIR}/stress_inside.json --set params.small_box_pixels=65536 --set params.backend=gl)
 tubes_render_test(accuracy.stress_grazing_rectangles
-  tubes-check --scene ${TUBES_DIR}/stress_grazing.json --set params.small_box_pixels=65536)
+  tubes-check --scene ${TUBES_DIR}/stress_grazing.json --set params.small_box_pixels=65536 --set params.backend=gl)
 # Thin tubes (segment length / radius up to ~300) seen from inside the set:
 # the case where an expanded quartic g would lose the bound to cancellation.
 tubes_render_test(accuracy.random_thin_close
@@ -74,41 +78,41 @@ endforeach()
 foreach(name stress_zero_length stress_zero_tangents stress_collinear stress_radius_zero_end stress_big_radius
              stress_offset stress_grazing stress_inside stress_near_plane bifurcation sharp_corner varying_radius)
   tubes_render_test(accuracy.prepass_on.${name} tubes-check --scene ${TUBES_DIR}/${name}.json
-    --set params.occlusion_prepass=on)
+    --set params.occlusion_prepass=on --set params.backend=gl)
 endforeach()
 tubes_render_test(accuracy.prepass_on.random_1
-  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 1 --set params.occlusion_prepass=on)
+  tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 1 --set params.occlusion_prepass=on --set params.backend=gl)
 tubes_render_test(accuracy.prepass_on.random_close
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 6 --set camera.orbit.distance=0.6
-  --set params.occlusion_prepass=on)
+  --set params.occlusion_prepass=on --set params.backend=gl)
 tubes_render_test(accuracy.prepass_on.random_dense
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 10 --set params.radius_scale=4
-  --set params.occlusion_prepass=on)
+  --set params.occlusion_prepass=on --set params.backend=gl)
 tubes_render_test(accuracy.prepass_on.random_thin_close
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 9 --set params.radius_scale=0.15
-  --set camera.orbit.distance=0.5 --set params.occlusion_prepass=on)
+  --set camera.orbit.distance=0.5 --set params.occlusion_prepass=on --set params.backend=gl)
 foreach(name stress_inside stress_near_plane)
   tubes_render_test(accuracy.prepass_off.${name} tubes-check --scene ${TUBES_DIR}/${name}.json
-    --set params.occlusion_prepass=off)
+    --set params.occlusion_prepass=off --set params.backend=gl)
 endforeach()
 tubes_render_test(accuracy.prepass_off.random_dense
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 10 --set params.radius_scale=4
-  --set params.occlusion_prepass=off)
+  --set params.occlusion_prepass=off --set params.backend=gl)
 # The same frame with the pre-pass on and off: identical depth everywhere (the
 # pre-pass only skips boxes that cannot win) and the same colours up to pixels
 # where two sub-segments hit within the shade pass's few-ulp tie rule.
 tubes_render_test(prepass.same_frame_dense
   ${CMAKE_COMMAND}
-  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_on.png|--depth|${TUBES_OUT}/dense_on.pfm|--samples|1|--set|params.occlusion_prepass=on"
-  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_off.png|--depth|${TUBES_OUT}/dense_off.pfm|--samples|1|--set|params.occlusion_prepass=off"
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_on.png|--set|params.backend=gl|--depth|${TUBES_OUT}/dense_on.pfm|--samples|1|--set|params.occlusion_prepass=on"
+  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_off.png|--set|params.backend=gl|--depth|${TUBES_OUT}/dense_off.pfm|--samples|1|--set|params.occlusion_prepass=off"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.pfm|${TUBES_OUT}/dense_off.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_on.png|${TUBES_OUT}/dense_off.png|--max-bad-pct|0.1"
   ${SL_STEPS})
 # With 4 MSAA samples the pre-pass renders the single-sample frame into every sample.
 tubes_render_test(prepass.msaa_same_as_single
   ${CMAKE_COMMAND}
-  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms4.png|--depth|${TUBES_OUT}/dense_ms4.pfm|--samples|4|--set|params.occlusion_prepass=on"
-  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms1.png|--depth|${TUBES_OUT}/dense_ms1.pfm|--samples|1|--set|params.occlusion_prepass=on"
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms4.png|--set|params.backend=gl|--depth|${TUBES_OUT}/dense_ms4.pfm|--samples|4|--set|params.occlusion_prepass=on"
+  "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/dense_prepass.json|--out|${TUBES_OUT}/dense_ms1.png|--set|params.backend=gl|--depth|${TUBES_OUT}/dense_ms1.pfm|--samples|1|--set|params.occlusion_prepass=on"
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.pfm|${TUBES_OUT}/dense_ms1.pfm|--max-abs|0"
   "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/dense_ms4.png|${TUBES_OUT}/dense_ms1.png|--max-abs|1"
   ${SL_STEPS})
@@ -143,7 +147,7 @@ tubes_render_test(detects.quadratic_vs_cubic_tight_bound
 foreach(method bisection illinois newton)
   tubes_render_test(accuracy.random_thin_${method}
     tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 9 --set params.radius_scale=0.15
-    --set camera.orbit.distance=0.5 --set params.root_method=${method})
+    --set camera.orbit.distance=0.5 --set params.root_method=${method} --set params.backend=gl)
 endforeach()
 # Data derivatives as they are (tornado velocities as tangents, not only their
 # direction): no NaN, the same bound.
@@ -154,7 +158,7 @@ tubes_render_test(accuracy.tornado_data_exact
 # (distance and colour); toggling it re-prepares nothing.
 tubes_render_test(culling.fewer_primitives_same_image
   tubes-check --scene ${TUBES_DIR}/random.json --random-segments 40 --seed 6 --set camera.orbit.distance=0.6
-  --culling-check)
+  --culling-check --set params.backend=gl)
 
 # Radii from a data attribute (shared line-style parameter radius_attribute):
 # the varying-radius tube with its radii moved into the colour scalar, drawn
@@ -193,7 +197,7 @@ tubes_render_test(detects.radius_scale_1_0015
 foreach(method bisection illinois newton)
   tubes_render_test(detects.iterations_1_${method}
     ${CMAKE_COMMAND}
-    "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--set|params.iterations=1|--set|params.root_method=${method}"
+    "-DSTEP1=$<TARGET_FILE:tubes-check>|--scene|${TUBES_DIR}/varying_radius.json|--set|params.iterations=1|--set|params.root_method=${method}|--set|params.backend=gl"
     -DEXIT1=1 "-DOUT1=${TUBES_CHECK_FAILED}" "-DERR1=(^|\n)  pixel \\([0-9]+,[0-9]+\\): gpu "
     ${SL_STEPS})
 endforeach()
@@ -273,3 +277,24 @@ tubes_render_test(golden.detects_uniform_error
   "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/bifurcation_plus5.png|${TUBES_DIR}/goldens/golden/bifurcation.png|${TUBES_GOLDEN_ARGS}"
   -DEXIT3=1 "-DOUT3=\"failed\":[ \t]*\\[\"max_mean\"\\]"
   ${SL_STEPS})
+
+# The two executions of one model (backend gl and embree, core/sl_backend.h): the golden
+# scenes and two data scenes rendered by both, colour over the covered pixels (mean <= 2 of
+# 255, the issue's bound) and distance on pixels both hit (absolute bound 1e-3 x the scene's
+# smallest radius; 0.5 % bad / coverage allowance for rims). Without Embree in the build the
+# embree step fails with the message naming the package (this build has it where the
+# renderer found it; tests/unit/test_tubes_backend.c covers the rule and the error).
+if(embree_FOUND AND NOT SIGHTLINE_NO_EMBREE)
+  foreach(pair bifurcation:1.2e-4 sharp_corner:1e-4 varying_radius:5e-5 hotroom:2.4e-5 tornado:1e-5)
+    string(REPLACE ":" ";" pair "${pair}")
+    list(GET pair 0 name)
+    list(GET pair 1 bound)
+    tubes_render_test(backend.gl_vs_embree.${name}
+      ${CMAKE_COMMAND}
+      "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/${name}.json|--out|${TUBES_OUT}/${name}_b_gl.png|--depth|${TUBES_OUT}/${name}_b_gl.pfm|--samples|1|--set|params.backend=gl"
+      "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${TUBES_DIR}/${name}.json|--out|${TUBES_OUT}/${name}_b_embree.png|--depth|${TUBES_OUT}/${name}_b_embree.pfm|--samples|1|--set|params.backend=embree"
+      "-DSTEP3=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}_b_gl.png|${TUBES_OUT}/${name}_b_embree.png|--max-mean|2|--background|26,26,31"
+      "-DSTEP4=$<TARGET_FILE:sightline-diff>|${TUBES_OUT}/${name}_b_gl.pfm|${TUBES_OUT}/${name}_b_embree.pfm|--bad-threshold|${bound}|--max-bad-pct|0.5|--max-coverage-pct|0.5"
+      ${SL_STEPS})
+  endforeach()
+endif()
