@@ -9,8 +9,9 @@
  * tube filter (bench/vtk_tubes.py, same llvmpipe) and Embree round Hermite
  * curves (peer-embree-tubes, CPU) read it too, with the same cameras: an eye
  * circling the data at distance 8 (frame 0: eye (0, 0, 8)), fov 45, constant
- * colour. Prints wall ms (median / min / max), GPU ms, prepare, peak RSS, GPU
- * memory and the ratios peer / ours. Checks nothing. Main thread = render thread.
+ * colour. `tubes` in both executions (backend auto = embree on software GL; gl with
+ * and without its occlusion pre-pass). Prints wall ms (median / min / max), GPU ms,
+ * prepare, peak RSS, GPU memory and the ratios peer / ours. Checks nothing. Main thread = render thread.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,14 +32,17 @@ typedef struct row {
     const char *technique, *label;
     const char *param;       /* one enum parameter that differs from the defaults, or NULL */
     const char *choice;
+    const char *param2, *choice2; /* a second one, or NULL */
 } row;
 
 static const row rows[] = {
-    {"tubes", "tubes (occlusion pre-pass auto)", NULL, NULL},
-    {"tubes", "tubes, pre-pass on", "occlusion_prepass", "on"},
-    {"tubes", "tubes, one pass (paper)", "occlusion_prepass", "off"},
-    {"tubes_mesh", "tubes_mesh (12 sides)", NULL, NULL},
-    {"voxel_lines", "voxel_lines opaque", NULL, NULL},
+    {"tubes", "tubes (default: backend auto)", NULL, NULL, NULL, NULL},
+    {"tubes", "tubes backend=embree", "backend", "embree", NULL, NULL},
+    {"tubes", "tubes backend=gl (occlusion pre-pass auto)", "backend", "gl", NULL, NULL},
+    {"tubes", "tubes backend=gl, pre-pass on", "occlusion_prepass", "on", "backend", "gl"},
+    {"tubes", "tubes backend=gl, one pass (paper)", "occlusion_prepass", "off", "backend", "gl"},
+    {"tubes_mesh", "tubes_mesh (12 sides)", NULL, NULL, NULL, NULL},
+    {"voxel_lines", "voxel_lines opaque", NULL, NULL, NULL, NULL},
 };
 #define ROW_COUNT ((int)(sizeof rows / sizeof rows[0]))
 
@@ -61,6 +65,8 @@ static sl_status params_for(const sl_technique *t, const row *r, const sl_datase
         st = sl_bench_set(p, "radius", 0.5 * (set->rmin + set->rmax), err);
     if (st == SL_OK && r->param)
         st = sl_bench_set_choice(p, r->param, r->choice, err);
+    if (st == SL_OK && r->param2)
+        st = sl_bench_set_choice(p, r->param2, r->choice2, err);
     return st;
 }
 

@@ -99,6 +99,8 @@ typedef struct sl_server_config {
     const char *default_dataset;   /* NULL: the first catalog dataset the first technique accepts */
     double test_frame_delay_ms;    /* tests only: sleep this x (frame pixels / session pixels) per frame */
     double test_frame_fixed_ms;    /* tests only: and this, whatever the size (a vertex-bound render) */
+    double test_frame_time_ms;     /* tests only, > 0: the adaptive scale sees this x (frame pixels / session
+                                      pixels) as a frame's time instead of the measured one (no sleep) */
     double test_load_delay_ms;     /* tests only: every dataset load sleeps this long first (loader thread) */
 } sl_server_config;
 

@@ -6,8 +6,9 @@
  * (texel centres at t * 255), an empty range giving the middle colour and NaN the
  * start; Lambert + Blinn-Phong, two-sided, with the light given in eye space
  * (x right, y up, z towards the viewer) turned into the view's world frame; the
- * result rounded to RGBA8 as GL stores a unorm8 colour. tests/unit/test_line_shade.c
- * checks it pixel by pixel against a GL draw of the GLSL. Any thread after init.
+ * result rounded to RGBA8 as GL stores a unorm8 colour. The tubes backend tests
+ * (unit.test_tubes_backend, render.tubes.backend.*) compare its frames with the GLSL's
+ * over the covered pixels. Any thread after init.
  */
 #ifndef SL_LINE_SHADE_H
 #define SL_LINE_SHADE_H

@@ -15,7 +15,6 @@
 
 #define TILE 16
 #define MAX_RETRACE 16
-#define RESIDUAL_OK 1e-4
 /* Curves and caps go to Embree this much fatter: its float intersector drops rays that graze a
  * tube within ~1e-5 r (random set seed 2: a rim ray 3e-5 r inside the sweep missed, so the
  * tube behind showed, 8.8 r deeper). Every candidate is then decided on the true sweep in
@@ -33,11 +32,6 @@ typedef struct piece {
     uint8_t exact;           /* a user primitive (else an Embree curve) */
 } piece;
 
-/* Embree's round-curve intersector lost hits inside a sub-segment that turned by 80 degrees
- * (random set seed 2, 8.8 r of depth): each half is cut (exactly, by de Casteljau) into
- * pieces that turn by at most this much, at most MAX_CUTS of them. */
-#define MAX_TURN_DEG 30.0
-#define MAX_CUTS 1
 
 /* A sphere point at an envelope's end: the node and the piece end that shades it. */
 typedef struct cap {
@@ -325,54 +319,12 @@ static void link_pieces(sl_tubes_embree *e)
     free(keys);
 }
 
-/* Degrees the quadratic's tangent turns over [0, 1] (it turns in one plane, monotonically). */
-static double turn_degrees(const sl_tubes_sweep *s)
-{
-    double a[3], b[3], aa = 0.0, bb = 0.0, ab = 0.0;
-    for (int c = 0; c < 3; c++) {
-        a[c] = s->b[1][c] - s->b[0][c];
-        b[c] = s->b[2][c] - s->b[1][c];
-        aa += a[c] * a[c];
-        bb += b[c] * b[c];
-        ab += a[c] * b[c];
-    }
-    if (!(aa > 0.0) || !(bb > 0.0))
-        return 180.0;
-    double cosine = fmin(fmax(ab / sqrt(aa * bb), -1.0), 1.0);
-    return acos(cosine) * 180.0 / 3.14159265358979323846;
-}
-
-/* The part [a, b] of a quadratic as a quadratic: c(a), c(a) + (b - a) c'(a) / 2, c(b). */
-static void cut_sweep(const sl_tubes_sweep *s, double a, double b, sl_tubes_sweep *out)
-{
-    double ua = 1.0 - a, ub = 1.0 - b;
-    for (int c = 0; c < 3; c++) {
-        double q[3] = {s->b[0][c], s->b[1][c], s->b[2][c]};
-        double ca = ua * ua * q[0] + 2.0 * ua * a * q[1] + a * a * q[2];
-        double cb = ub * ub * q[0] + 2.0 * ub * b * q[1] + b * b * q[2];
-        double da = 2.0 * (ua * (q[1] - q[0]) + a * (q[2] - q[1]));
-        out->b[0][c] = ca;
-        out->b[1][c] = ca + 0.5 * (b - a) * da;
-        out->b[2][c] = cb;
-    }
-    const double *r = s->r;
-    double ra = ua * ua * r[0] + 2.0 * ua * a * r[1] + a * a * r[2];
-    double rb = ub * ub * r[0] + 2.0 * ub * b * r[1] + b * b * r[2];
-    double dra = 2.0 * (ua * (r[1] - r[0]) + a * (r[2] - r[1]));
-    out->r[0] = ra;
-    out->r[1] = ra + 0.5 * (b - a) * dra;
-    out->r[2] = rb;
-}
-
-/* Appends the pieces of one half (cut by its turn) to e->pieces. */
+/* Appends one half as a piece to e->pieces (the piece table allows a half to be cut into
+ * several; one piece per half is what the accuracy tests measured). */
 static sl_status add_half(sl_tubes_embree *e, const piece *half, size_t index)
 {
-    int cuts = (int)ceil(turn_degrees(&half->sweep) / MAX_TURN_DEG);
-    cuts = cuts < 1 ? 1 : (cuts > MAX_CUTS ? MAX_CUTS : cuts);
-    if (e->piece_count + (size_t)cuts > e->piece_capacity) {
+    if (e->piece_count + 1 > e->piece_capacity) {
         size_t cap = e->piece_capacity ? 2 * e->piece_capacity : 2 * e->segment_count + 16;
-        while (cap < e->piece_count + (size_t)cuts)
-            cap *= 2;
         piece *grown = realloc(e->pieces, cap * sizeof *grown);
         if (!grown)
             return SL_ERR_NOMEM;
@@ -380,16 +332,12 @@ static sl_status add_half(sl_tubes_embree *e, const piece *half, size_t index)
         e->piece_capacity = cap;
     }
     e->half_first[index] = (uint32_t)e->piece_count;
-    e->half_cuts[index] = (uint8_t)cuts;
-    for (int i = 0; i < cuts; i++) {
-        piece *p = &e->pieces[e->piece_count++];
-        *p = *half;
-        p->exact = 0;
-        p->t0 = (float)i / (float)cuts;
-        p->t1 = (float)(i + 1) / (float)cuts;
-        if (cuts > 1)
-            cut_sweep(&half->sweep, (double)i / cuts, (double)(i + 1) / cuts, &p->sweep);
-    }
+    e->half_cuts[index] = 1;
+    piece *p = &e->pieces[e->piece_count++];
+    *p = *half;
+    p->exact = 0;
+    p->t0 = 0.0f;
+    p->t1 = 1.0f;
     return SL_OK;
 }
 

@@ -3,21 +3,22 @@
  * The model is the GL path's exactly: every Hermite segment split into the two quadratic
  * Bézier sub-segments of tubes.geom.glsl (positions, radii and colour scalars, computed
  * in float the same way), each the sweep of a sphere (the union of its spheres, end
- * spheres included). A sub-segment whose sweep has a smooth envelope (radius > 0, the
- * centre faster than the radius changes, radius below the curvature radius) goes to
- * Embree as a RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE (the quadratic written as a cubic
- * Hermite), with sphere points where the envelope ends (line ends, corners, bifurcations);
- * any other sub-segment (zero length, |r'| >= |p'|, negative radius, tight folds) is a
- * user primitive intersected exactly in double (tubes_sweep.c). Embree's hits are float:
- * where a hit's residual against the double sweep exceeds 1e-4 r, it is refined by
- * Newton steps on the entry distance in double; a ray that starts inside the sweep skips
- * exits and sees the next entry beyond the near plane, as in the GL path.
+ * spheres included). A sub-segment whose sweep has a smooth envelope (tubes_sweep.h) goes
+ * to Embree as a RTC_GEOMETRY_TYPE_ROUND_BEZIER_CURVE (the quadratic degree-elevated),
+ * with sphere points where an envelope ends (line ends, corners, bifurcations); any other
+ * sub-segment, and any beside one, is a user primitive intersected exactly in double
+ * (tubes_sweep.c). Embree sees curves and caps 2 % fatter, and every candidate it returns
+ * is decided on the true sweep in double (Newton, else the exact search, hopping across
+ * joints), candidates taken in turn until the next lies beyond the best entry: Embree's
+ * float intersector drops grazing rays and cuts curves at their end planes (README.md).
+ * A ray that starts inside the sweep sees the next entry beyond the near plane, as in the
+ * GL path.
  *
  * One Embree device and scene per prepared dataset; the BVH is rebuilt only when the
  * radii change (a camera, colour or light change only traces). Frames are traced in
  * 16x16 tiles by sl_parallel_run (all cores, SIGHTLINE_THREADS overrides), 16-, 8- or
- * 4-ray packets of coherent primary rays, shaded with sl_line_shade.h into an
- * sl_host_frame. Built only with Embree (SL_HAVE_EMBREE); without it
+ * 4-ray packets of coherent primary rays (single rays for the candidates after the first),
+ * shaded with sl_line_shade.h into an sl_host_frame. Built only with Embree (SL_HAVE_EMBREE); without it
  * sl_tubes_embree_available() is 0 and create fails. Render thread, except that the
  * tracing runs on the worker threads it starts.
  */

@@ -269,22 +269,6 @@ int sl_tubes_sweep_intersect(const sl_tubes_sweep *s, const double o[3], const d
     return found;
 }
 
-double sl_tubes_sweep_residual(const sl_tubes_sweep *s, const double o[3], const double d[3], double l, double t)
-{
-    double c[3], dc[3], r, dr;
-    eval_d(s, t, c, dc, &r, &dr);
-    double x[3] = {o[0] + l * d[0] - c[0], o[1] + l * d[1] - c[1], o[2] + l * d[2] - c[2]};
-    double ar = fabs(r);
-    if (!(ar > 0.0))
-        return INFINITY;
-    double radial = fabs(sqrt(dot3(x, x)) - ar);
-    double speed = sqrt(dot3(dc, dc));
-    double along = speed > 0.0 ? fabs(dot3(x, dc) + r * dr) / speed : INFINITY;
-    /* along the tangent the sphere leaves the envelope to second order: 0.01 r of offset
-     * is ~1e-4 r of depth, so weigh it by 1/100 against the radial residual */
-    return fmax(radial, 0.01 * along) / ar;
-}
-
 int sl_tubes_sweep_refine(const sl_tubes_sweep *s, const double o[3], const double d[3], double l_min, double t0,
                           double *l, double *t)
 {

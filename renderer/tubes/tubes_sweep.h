@@ -10,8 +10,8 @@
  * sl_tubes_sweep_intersect finds the parameter intervals where the ray meets the spheres
  * exactly (the roots of the quartic r^2 - |q|^2 + (d.q)^2, isolated between the roots of
  * its derivatives), samples l at 33 points of each and polishes every sampled minimum
- * by golden-section search; sl_tubes_sweep_refine polishes a float hit near a known t by Newton steps on
- * l'(t). sl_tubes_sweep_regular says whether the sweep has the smooth envelope that
+ * by golden-section search; sl_tubes_sweep_refine polishes a float hit near a known t by
+ * Newton steps on l'(t). sl_tubes_sweep_regular says whether the sweep has the smooth envelope that
  * Embree's round curves assume. Pure functions, any thread.
  */
 #ifndef SL_TUBES_SWEEP_H
@@ -31,10 +31,6 @@ int sl_tubes_sweep_regular(const sl_tubes_sweep *s);
 /* The nearest entry at l >= l_min and l < l_max: 1 and *l, *t; 0 when none. */
 int sl_tubes_sweep_intersect(const sl_tubes_sweep *s, const double o[3], const double d[3], double l_min,
                              double l_max, double *l, double *t);
-
-/* Residual of a hit at distance l on the sphere of parameter t: max of |dist - r| and the
- * offset along the tangent from the contact circle, over r (0 = exact). */
-double sl_tubes_sweep_residual(const sl_tubes_sweep *s, const double o[3], const double d[3], double l, double t);
 
 /* Newton on l'(t) from t0 (steps of at most 0.1, downhill where l is not convex, at most
  * 16, clamped to [0, 1]): 1 with the refined *l, *t when it converged to a local minimum
