@@ -10,7 +10,11 @@
  * writer's numbering, which element lists index). Refused, by line number:
  * surfaces, rat = 1 and orders above 4 (SL_ERR_UNSUPPORTED), counts above
  * sl_lr.h's limits or beyond what the bytes can hold (before allocating),
- * fewer or more records than announced, a second patch, malformed records;
+ * fewer or more records than announced, a second patch, malformed records,
+ * mesh rectangles that are not flat, are points, reach outside the domain
+ * (the elements' union) or repeat a knot beyond the order. Mesh rectangles
+ * flat in two directions (segments) are accepted and kept as read: the
+ * reference library writes them (issue 31); they split nothing.
  * sl_lr_finish then checks coverage, partition of unity, gaps and overlaps.
  * Two passes (check and count, then fill exact arrays). Any thread; no GL.
  */
@@ -144,6 +148,14 @@ typedef struct lr_header {
     int order[3], dim;
     size_t basis, rects, elements;
 } lr_header;
+
+/* The domain box: the union of the element boxes, gathered by the first
+ * pass so the second can check the mesh rectangles (read before the
+ * elements) against it, with their line numbers. */
+typedef struct lr_domain {
+    double lo[3], hi[3];
+    int known;
+} lr_domain;
 
 static int starts_with(lr_cursor *c, const char *s)
 {
@@ -306,7 +318,13 @@ static sl_status read_basis(lr_cursor *c, const lr_header *h, size_t i, sl_lr_ba
     return st;
 }
 
-static sl_status read_rect(lr_cursor *c, const lr_header *h, size_t i, sl_lr_meshrect *out, sl_err *err)
+/* Mesh rectangle i. Flat in one direction, or in two: a segment, which the
+ * reference library keeps from merging overlapping rectangles (it splits
+ * nothing, so the spline does not depend on it; kept as read). The constant
+ * direction whose order bounds the multiplicity is the reference reader's
+ * (sl_lr_meshrect_const_dir). With `domain` known, the extent must lie in it. */
+static sl_status read_rect(lr_cursor *c, const lr_header *h, const lr_domain *domain, size_t i,
+                           sl_lr_meshrect *out, sl_err *err)
 {
     char what[64];
     snprintf(what, sizeof what, "mesh rectangle %zu", i);
@@ -339,19 +357,25 @@ static sl_status read_rect(lr_cursor *c, const lr_header *h, size_t i, sl_lr_mes
         st = expect(c, ')', what, err);
     if (st != SL_OK)
         return st;
-    int flat = -1, flats = 0;
+    int flats = 0;
     for (int d = 0; d < 3; d++) {
         if (m.hi[d] < m.lo[d])
             return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s: %c extent [%.17g, %.17g] is reversed", line, what,
                               axis_name[d], m.lo[d], m.hi[d]);
-        if (m.hi[d] == m.lo[d]) {
-            flat = d;
-            flats++;
-        }
+        if (domain && domain->known && (m.lo[d] < domain->lo[d] || m.hi[d] > domain->hi[d]))
+            return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s: %c extent [%.17g, %.17g] is outside the domain"
+                              " [%.17g, %.17g] (the union of the elements)", line, what, axis_name[d], m.lo[d],
+                              m.hi[d], domain->lo[d], domain->hi[d]);
+        flats += m.hi[d] == m.lo[d];
     }
-    if (flats != 1)
-        return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s has %d constant directions (a mesh rectangle has"
-                          " exactly one)", line, what, flats);
+    if (flats == 0)
+        return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s has 0 constant directions (a mesh rectangle is"
+                          " constant in one, or in two for the segments the reference library keeps)", line,
+                          what);
+    if (flats == 3)
+        return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s has 3 constant directions (a point, not a mesh"
+                          " rectangle)", line, what);
+    int flat = sl_lr_meshrect_const_dir(&m);
     /* A knot repeated more than `order` times leaves no basis function with support across it. */
     if (mult > h->order[flat])
         return sl_err_set(err, SL_ERR_FORMAT, "line %zu: %s: multiplicity %lld exceeds the order %d in %c", line,
@@ -363,9 +387,10 @@ static sl_status read_rect(lr_cursor *c, const lr_header *h, size_t i, sl_lr_mes
 }
 
 /* Element i; with `lr` set, fills it (ids at lr->element_basis + *offset,
- * `stamp` catching a basis id listed twice); always adds its id count. */
+ * `stamp` catching a basis id listed twice); always adds its id count; with
+ * `domain` set, grows it by the element's box. */
 static sl_status read_element(lr_cursor *c, const lr_header *h, size_t i, sl_lr_volume *lr, uint32_t *stamp,
-                              size_t *offset, sl_err *err)
+                              size_t *offset, lr_domain *domain, sl_err *err)
 {
     char what[64];
     snprintf(what, sizeof what, "element %zu", i);
@@ -437,6 +462,13 @@ static sl_status read_element(lr_cursor *c, const lr_header *h, size_t i, sl_lr_
         st = expect(c, '}', what, err);
     if (st != SL_OK)
         return st;
+    if (domain) {
+        for (int d = 0; d < 3; d++) {
+            domain->lo[d] = domain->known ? fmin(domain->lo[d], box[0][d]) : box[0][d];
+            domain->hi[d] = domain->known ? fmax(domain->hi[d], box[1][d]) : box[1][d];
+        }
+        domain->known = 1;
+    }
     if (lr) {
         sl_lr_element *e = &lr->elements[i];
         for (int d = 0; d < 3; d++) {
@@ -450,10 +482,12 @@ static sl_status read_element(lr_cursor *c, const lr_header *h, size_t i, sl_lr_
     return SL_OK;
 }
 
-/* One pass over the records after the header; with lr NULL it only checks
- * and counts the element basis entries into *element_basis. */
+/* One pass over the records after the header; with lr NULL it only checks,
+ * counts the element basis entries into *element_basis and gathers the
+ * domain; with lr set it fills lr and checks the mesh rectangles against the
+ * domain the first pass gathered. */
 static sl_status walk(lr_cursor *c, const lr_header *h, sl_lr_volume *lr, uint32_t *stamp,
-                      size_t *element_basis, sl_err *err)
+                      size_t *element_basis, lr_domain *domain, sl_err *err)
 {
     sl_status st = SL_OK;
     for (size_t i = 0; i < h->basis && st == SL_OK; i++) {
@@ -464,13 +498,13 @@ static sl_status walk(lr_cursor *c, const lr_header *h, sl_lr_volume *lr, uint32
     for (size_t i = 0; i < h->rects && st == SL_OK; i++) {
         st = record_start(c, 'r', i, h->rects, err);
         if (st == SL_OK)
-            st = read_rect(c, h, i, lr ? &lr->meshrects[i] : NULL, err);
+            st = read_rect(c, h, lr ? domain : NULL, i, lr ? &lr->meshrects[i] : NULL, err);
     }
     size_t offset = 0;
     for (size_t i = 0; i < h->elements && st == SL_OK; i++) {
         st = record_start(c, 'e', i, h->elements, err);
         if (st == SL_OK)
-            st = read_element(c, h, i, lr, stamp, &offset, err);
+            st = read_element(c, h, i, lr, stamp, &offset, lr ? NULL : domain, err);
         if (st == SL_OK && offset > SL_LR_MAX_ELEMENT_BASIS)
             st = sl_err_set(err, SL_ERR_LIMIT, "the elements list more than %u basis ids in all",
                             SL_LR_MAX_ELEMENT_BASIS);
@@ -510,6 +544,7 @@ sl_status sl_load_lr(const uint8_t *data, size_t size, const char *path, sl_data
         size = 0;
     lr_cursor c = {.d = data, .n = size, .line = 1};
     lr_header h = {0};
+    lr_domain domain = {0};
     sl_dataset *ds = NULL;
     sl_lr_volume *lr = NULL;
     uint32_t *stamp = NULL;
@@ -517,7 +552,7 @@ sl_status sl_load_lr(const uint8_t *data, size_t size, const char *path, sl_data
     sl_status st = read_header(&c, &h, err);
     lr_cursor body = c;
     if (st == SL_OK)
-        st = walk(&c, &h, NULL, NULL, &element_basis, err);
+        st = walk(&c, &h, NULL, NULL, &element_basis, &domain, err);
     if (st != SL_OK)
         goto fail;
     lr = calloc(1, sizeof *lr);
@@ -534,7 +569,7 @@ sl_status sl_load_lr(const uint8_t *data, size_t size, const char *path, sl_data
     lr->dim = h.dim;
     c = body;
     size_t again = 0;
-    st = walk(&c, &h, lr, stamp, &again, err);
+    st = walk(&c, &h, lr, stamp, &again, &domain, err);
     if (st == SL_OK)
         st = sl_lr_finish(lr, err);
     if (st == SL_OK)

@@ -1,5 +1,7 @@
 /* lr_model.c — allocation, validation and derived fields of an LR-spline
- * volume model, and the linear element search (see sl_lr.h).
+ * volume model, the mesh-rectangle rule shared with the loader, and the
+ * linear element search (see sl_lr.h). Mesh rectangles are checked against
+ * the domain box the elements span, so after the elements.
  * Any thread; no GL. */
 #include "sl_lr.h"
 #include "lr_index.h"
@@ -82,6 +84,42 @@ static sl_status check_basis(const sl_lr_volume *lr, size_t i, sl_err *err)
     return SL_OK;
 }
 
+int sl_lr_meshrect_const_dir(const sl_lr_meshrect *m)
+{
+    int dir = -1;
+    for (int d = 0; d < 3; d++)
+        if (m->lo[d] == m->hi[d])
+            dir = d;
+    return dir;
+}
+
+/* Mesh rectangle i against the domain box (filled from the elements):
+ * flat in one or two directions (a segment, as the reference library keeps
+ * them), inside the closed box, multiplicity within the order. */
+static sl_status check_meshrect(const sl_lr_volume *lr, size_t i, sl_err *err)
+{
+    const sl_lr_meshrect *m = &lr->meshrects[i];
+    int flat = 0;
+    for (int d = 0; d < 3; d++) {
+        if (!isfinite(m->lo[d]) || !isfinite(m->hi[d]) || m->hi[d] < m->lo[d])
+            return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu: bad extent in %c", i, axis_name[d]);
+        if (m->lo[d] < lr->domain_lo[d] || m->hi[d] > lr->domain_hi[d])
+            return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu: %c extent [%.17g, %.17g] is outside the"
+                              " domain [%.17g, %.17g]", i, axis_name[d], m->lo[d], m->hi[d], lr->domain_lo[d],
+                              lr->domain_hi[d]);
+        flat += m->lo[d] == m->hi[d];
+    }
+    if (flat == 0)
+        return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu is not flat in any direction", i);
+    if (flat == 3)
+        return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu is a point (flat in all three directions)", i);
+    int d = sl_lr_meshrect_const_dir(m);
+    if (m->multiplicity < 1 || m->multiplicity > lr->order[d])
+        return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu: multiplicity %d is outside 1..%d (the order"
+                          " in %c)", i, m->multiplicity, lr->order[d], axis_name[d]);
+    return SL_OK;
+}
+
 /* Whether basis b's support covers the element box and no knot of b lies
  * strictly inside it (the box is inside one polynomial piece). */
 static int basis_covers(const sl_lr_volume *lr, const sl_lr_basis *b, const sl_lr_element *e)
@@ -127,18 +165,6 @@ sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err)
         if (st != SL_OK)
             return st;
     }
-    for (size_t i = 0; i < lr->meshrect_count; i++) {
-        const sl_lr_meshrect *m = &lr->meshrects[i];
-        int flat = 0;
-        for (int d = 0; d < 3; d++) {
-            if (!isfinite(m->lo[d]) || !isfinite(m->hi[d]) || m->hi[d] < m->lo[d])
-                return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu: bad extent in %c", i, axis_name[d]);
-            flat += m->lo[d] == m->hi[d];
-        }
-        if (flat != 1 || m->multiplicity < 1)
-            return sl_err_set(err, SL_ERR_FORMAT, "mesh rectangle %zu: not a rectangle of one constant"
-                              " direction with multiplicity >= 1", i);
-    }
     for (int d = 0; d < 3; d++) {
         lr->domain_lo[d] = DBL_MAX;
         lr->domain_hi[d] = -DBL_MAX;
@@ -175,6 +201,11 @@ sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err)
                 return sl_err_set(err, SL_ERR_FORMAT, "element %zu: listed basis function %u does not"
                                   " cover it with one polynomial piece", i, id);
         }
+    }
+    for (size_t i = 0; i < lr->meshrect_count; i++) {
+        sl_status st = check_meshrect(lr, i, err);
+        if (st != SL_OK)
+            return st;
     }
     double domain_volume = 1.0;
     for (int d = 0; d < 3; d++)

@@ -12,7 +12,10 @@
  * The box mesh is kept as the format gives it: mesh rectangles (one extent
  * zero: the constant direction) with multiplicity, and elements (boxes of
  * the mesh, disjoint, tiling the domain) each listing the basis functions
- * whose support covers it.
+ * whose support covers it. Mesh rectangles may also be segments (two extents
+ * zero), as the reference library keeps them from merging overlapping
+ * rectangles (issue 31): they split no element and no basis function, so the
+ * spline never depends on them; they are kept and written back as read.
  *
  * Element rule (documented once, used by every look-up structure): a point p
  * lies in the element with lo[d] <= p[d] < hi[d] for every d, except that on
@@ -50,8 +53,8 @@ typedef struct sl_lr_basis {
 } sl_lr_basis;
 
 typedef struct sl_lr_meshrect {
-    double lo[3], hi[3];                  /* exactly one d has lo[d] == hi[d] */
-    int multiplicity;                     /* >= 1 */
+    double lo[3], hi[3];                  /* one d with lo[d] == hi[d], or two (a segment) */
+    int multiplicity;                     /* 1..order of sl_lr_meshrect_const_dir */
 } sl_lr_meshrect;
 
 typedef struct sl_lr_element {
@@ -86,9 +89,18 @@ sl_status sl_lr_alloc(sl_lr_volume *lr, size_t basis_count, size_t meshrect_coun
                       size_t element_count, size_t element_basis_count, sl_err *err);
 void sl_lr_free(sl_lr_volume *lr);
 
+/* The constant direction of a mesh rectangle, as the reference library
+ * reads it (LR::MeshRectangle::read): the last d with lo[d] == hi[d], so a
+ * segment's is the higher of its two; -1 when there is none. Its
+ * multiplicity is bounded by the order in that direction. */
+int sl_lr_meshrect_const_dir(const sl_lr_meshrect *m);
+
 /* Checks a filled model and computes the derived fields. Refuses, by index
  * and reason: an order or dim out of range; non-finite numbers; knots out of
- * order or a basis function of empty support; gamma <= 0; an element box
+ * order or a basis function of empty support; gamma <= 0; a mesh rectangle
+ * that is not flat, is a point (flat in all three directions), reaches
+ * outside the domain box or has a multiplicity outside 1..the order in its
+ * constant direction (segments are accepted); an element box
  * that is empty, outside the domain or not covered by a listed basis
  * function's support; a basis id out of range; element basis lists that
  * overrun element_basis; elements whose volumes do not add up to the domain

@@ -12,7 +12,8 @@
  * tests/data/lr/two_lines.lr (two partial mesh lines, scaling weights 7/16,
  * made by make_two_lines.py), equal to its tensor spline to 1e-12.
  * Hostile files: lying counts both ways, knots out of order, a basis id out
- * of range or listed twice, an element no listed basis covers, wrong ids,
+ * of range or listed twice, a mesh rectangle outside the domain or a point
+ * (a segment loads: test_load_lr_degenerate.c has the reference's), an element no listed basis covers, wrong ids,
  * truncation (every prefix of a small file), a truncated gzip, rat = 1,
  * order 5, surfaces, a second patch, garbage, huge counts in a tiny file.
  */
@@ -205,6 +206,23 @@ static void test_refined(void)
     free(t);
     t = replace(refined_text(), "[0.5, 0.5] x [0, 1]", "[0.5, 0.6] x [0, 1]");
     expect_refused("mesh rectangle with no constant direction", t, SL_ERR_FORMAT, "0 constant directions");
+    free(t);
+    t = replace(refined_text(), "[0.5, 0.5] x [0, 1] x [0, 1] (1)", "[0.5, 0.5] x [0, 3] x [0, 1] (1)");
+    expect_refused("mesh rectangle outside the domain", t, SL_ERR_FORMAT, "line 20: mesh rectangle 1: v extent"
+                   " [0, 3] is outside the domain [0, 2]");
+    free(t);
+    t = replace(refined_text(), "[0.5, 0.5] x [0, 1] x [0, 1] (1)", "[0.5, 0.5] x [1, 1] x [0, 1] (1)");
+    {
+        sl_err e = {0};
+        sl_status s = SL_OK;
+        sl_dataset *seg = load_text(t, &s, &e);
+        SL_CHECK_MSG(s == SL_OK && seg && seg->lr->meshrects[1].lo[1] == 1 && seg->lr->meshrects[1].hi[1] == 1,
+                     "a segment (two constant directions) refused: %s", e.message);
+        sl_dataset_destroy(seg);
+    }
+    free(t);
+    t = replace(refined_text(), "[0.5, 0.5] x [0, 1] x [0, 1] (1)", "[0.5, 0.5] x [1, 1] x [1, 1] (1)");
+    expect_refused("a point", t, SL_ERR_FORMAT, "line 20: mesh rectangle 1 has 3 constant directions");
     free(t);
     t = replace(refined_text(), "[0.5, 0.5] x [0, 1] x [0, 1] (1)", "[0.5, 0.5] x [0, 1] x [0, 1] (4)");
     expect_refused("multiplicity above the order", t, SL_ERR_FORMAT, "multiplicity 4 exceeds the order 3");
