@@ -103,7 +103,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         header = nl + 1;
     }
     char peer[SL_CLIENT_ADDRESS_MAX];
-    snprintf(peer, sizeof peer, "%s", buf);
+    size_t peer_len = strnlen(buf, sizeof peer - 1);
+    memcpy(peer, buf, peer_len);
+    peer[peer_len] = '\0';
 
     char got[SL_CLIENT_ADDRESS_MAX], want[SL_CLIENT_ADDRESS_MAX];
     sl_client_address_source s = sl_client_address_resolve(peer, header, t, nt, got, sizeof got);

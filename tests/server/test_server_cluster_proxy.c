@@ -6,6 +6,8 @@
  *  1. a forged X-Forwarded-For sent straight to the node from 127.0.0.2 (not a
  *     trusted proxy) changes nothing: five silent upgrades, each naming another
  *     address, are counted as 127.0.0.2's, so the fifth is refused;
+ *     from 127.0.0.1 (trusted, as the balancer) the header names the client, two
+ *     header lines read as one list, and an entry with a port is malformed;
  *  2. one source (127.0.0.3) opens 64 silent WebSockets through the balancer, each
  *     with a forged X-Forwarded-For of its own: the node counts all of them as
  *     127.0.0.3 (its 4 pending, 60 refused), since the balancer replaces the header;
@@ -141,7 +143,7 @@ int main(void)
     CHECK(harness_wait_metric(node, "sightline_pending_connections", 0, 10000) == 0, "pending did not drop to 0");
 
     /* 1. A forged header straight to the node from an untrusted address changes nothing. */
-    double ignored0 = harness_metric(node, "sightline_forwarded_ignored_total");
+    double forwarded0 = 0, ignored0 = harness_metric(node, "sightline_forwarded_ignored_total");
     double refused0 = harness_metric(node, "sightline_refused_address_total");
     int direct[5];
     for (int i = 0; i < 5; i++) {
@@ -162,8 +164,33 @@ int main(void)
     close_all(direct, 5);
     CHECK(harness_wait_metric(node, "sightline_pending_connections", 0, 10000) == 0, "pending did not drop to 0");
 
+    /* 1b. From the trusted address (127.0.0.1, as the balancer) the header names the client:
+     * two header lines are one list (the client is the last line's entry), and garbage
+     * leaves the client as the proxy itself. */
+    forwarded0 = harness_metric(node, "sightline_forwarded_clients_total");
+    double malformed0 = harness_metric(node, "sightline_forwarded_malformed_total");
+    int trusted[6];
+    for (int i = 0; i < 5; i++) {
+        char header[96];
+        snprintf(header, sizeof header, "6.6.6.6\r\nX-Forwarded-For: 192.0.2.%d", i + 1);
+        trusted[i] = silent_upgrade(node, "127.0.0.1", header);
+    }
+    trusted[5] = silent_upgrade(node, "127.0.0.1", "192.0.2.77:4711");
+    int trusted_in = 0;
+    for (int i = 0; i < 6; i++)
+        trusted_in += trusted[i] >= 0;
+    CHECK(trusted_in == 6, "%d of 6 silent upgrades forwarded by the trusted address for distinct clients got in",
+          trusted_in);
+    CHECK(harness_metric(node, "sightline_forwarded_clients_total") - forwarded0 == 5 &&
+              harness_metric(node, "sightline_forwarded_malformed_total") - malformed0 == 1,
+          "from the trusted address: %g forwarded (want 5), %g malformed (want 1)",
+          harness_metric(node, "sightline_forwarded_clients_total") - forwarded0,
+          harness_metric(node, "sightline_forwarded_malformed_total") - malformed0);
+    close_all(trusted, 6);
+    CHECK(harness_wait_metric(node, "sightline_pending_connections", 0, 10000) == 0, "pending did not drop to 0");
+
     /* 2. One source, 64 silent WebSockets through the balancer, each forging its own address. */
-    double forwarded0 = harness_metric(node, "sightline_forwarded_clients_total");
+    forwarded0 = harness_metric(node, "sightline_forwarded_clients_total");
     refused0 = harness_metric(node, "sightline_refused_address_total");
     int flood[FLOOD], held = 0;
     for (int i = 0; i < FLOOD; i++) {

@@ -53,9 +53,10 @@ static const char *resolve(const char *peer, const char *header, const char *con
 #define RESOLVES(peer, header, trusted, want, want_src)                                                      \
     do {                                                                                                     \
         sl_client_address_source s_;                                                                         \
-        const char *got_ = resolve(peer, header, trusted, (int)(sizeof trusted / sizeof trusted[0]), &s_);   \
+        const char *h_ = (header);                                                                           \
+        const char *got_ = resolve(peer, h_, trusted, (int)(sizeof trusted / sizeof trusted[0]), &s_);       \
         SL_CHECK_MSG(strcmp(got_, want) == 0 && s_ == want_src, "peer %s header \"%.80s\": %s (source %d), not %s (%d)", \
-                     peer, header ? header : "(none)", got_, (int)s_, want, (int)want_src);                  \
+                     peer, h_ ? h_ : "(none)", got_, (int)s_, want, (int)want_src);                  \
     } while (0)
 
 int main(void)
