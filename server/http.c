@@ -130,6 +130,12 @@ char *sl_http_metrics(sl_server *srv)
          m.refused_address},
         {"sightline_pending_evicted_total", "Connections without hello closed to make room (--max-pending).",
          m.pending_evicted},
+        {"sightline_forwarded_clients_total", "WebSocket upgrades whose client address came from a "
+         "--trusted-proxy's X-Forwarded-For.", m.forwarded_clients},
+        {"sightline_forwarded_ignored_total", "WebSocket upgrades with an X-Forwarded-For from a peer that is not "
+         "a --trusted-proxy (ignored).", m.forwarded_ignored},
+        {"sightline_forwarded_malformed_total", "WebSocket upgrades from a --trusted-proxy whose X-Forwarded-For "
+         "did not parse (the last trusted hop was used).", m.forwarded_malformed},
     };
     for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++)
         append(&b, &len, &cap, "# HELP %s %s\n# TYPE %s counter\n%s %llu\n", counters[i].name, counters[i].help,

@@ -5,6 +5,7 @@
  *                    [--max-pending N] [--max-pending-per-address N]
  *                    [--max-sessions N] [--grace S] [--idle-release S] [--egl-device D]
  *                    [--default-dataset NAME] [--hello-timeout S] [--node-id NAME] [--agent-port P]
+ *                    [--trusted-proxy ADDR[/BITS]]...
  *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-frame-time-ms MS]
  *                    [--test-load-delay-ms MS]   (the --test-* options are for tests only)
  *   sightline-server [--db PATH|URL] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
@@ -77,7 +78,7 @@ static void usage(FILE *f)
             "                        [--allow-origin URL]... [--max-clients N] [--max-pending N]\n"
             "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--idle-release SECONDS] [--egl-device software|INDEX] [--default-dataset NAME]\n"
-            "                        [--hello-timeout S] [--node-id NAME] [--agent-port P]\n"
+            "                        [--hello-timeout S] [--node-id NAME] [--agent-port P] [--trusted-proxy ADDR[/BITS]]...\n"
             "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-frame-time-ms MS] [--test-load-delay-ms MS]\n"
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
             "                        frame's render, and MS before every dataset load, so a scene is slow in a\n"
@@ -94,6 +95,9 @@ static void usage(FILE *f)
             "                    sanitized); nodes sharing one catalog need distinct ids\n"
             "  --agent-port P    HAProxy agent-check on TCP port P (0, the default: off): \"up ready W%%\"\n"
             "                    (W falls with the sessions), \"drain\" while draining\n"
+            "  --trusted-proxy ADDR[/BITS]  a balancer (IPv4 or IPv6, up to 16): an upgrade from it is\n"
+            "                    counted against the client X-Forwarded-For names (the rightmost entry\n"
+            "                    that is not a trusted proxy); from any other peer the header is ignored\n"
             "  SIGTERM drains: no new sessions (`draining`), existing ones are served until their clients\n"
             "  leave or --grace seconds pass, then exit 0; a second SIGTERM or SIGINT stops at once\n");
 }
@@ -284,6 +288,17 @@ int main(int argc, char **argv)
                 return 2;
             }
             snprintf(cfg.node_id, sizeof cfg.node_id, "%s", v), i++;
+        } else if (strcmp(a, "--trusted-proxy") == 0 && v) {
+            sl_err perr = {0};
+            if (cfg.trusted_proxy_count >= SL_TRUSTED_PROXY_MAX) {
+                fprintf(stderr, "sightline-server: at most %d --trusted-proxy options\n", SL_TRUSTED_PROXY_MAX);
+                return 2;
+            }
+            if (sl_net_prefix_parse(v, &cfg.trusted_proxies[cfg.trusted_proxy_count], &perr) != SL_OK) {
+                fprintf(stderr, "sightline-server: %s\n", perr.message);
+                return 2;
+            }
+            cfg.trusted_proxy_count++, i++;
         } else if (strcmp(a, "--agent-port") == 0 && v) {
             ok = parse_int(v, 0, 65535, &cfg.agent_port), i++;
         } else if (strcmp(a, "--default-dataset") == 0 && v) {

@@ -25,6 +25,9 @@
  *              over the data-access layer db.c + db_sqlite.c / db_pg.c (sl_db.h)
  *   http.c     /healthz and /metrics bodies (service thread)
  *   http_host.c  the Host / Origin rules, pure (sl_http_host.h; any thread)
+ *   client_address.c  --trusted-proxy prefixes and the X-Forwarded-For walk, pure
+ *              (sl_client_address.h; any thread); ws_client_address.c reads the
+ *              header of an upgrade (service thread)
  * Every *_ms timestamp is sl_clock_ms (core/sl_clock.h), so all of them compare.
  *
  * Threads: the lws service thread owns sockets, clients, the catalog; the
@@ -59,6 +62,7 @@
 #include "core/sl_params.h"
 #include "core/sl_status.h"
 #include "sl_catalog.h"
+#include "sl_client_address.h"
 #include "sl_protocol.h"
 
 struct lws;
@@ -89,7 +93,10 @@ typedef struct sl_server_config {
     int origin_count;
     int max_clients;               /* default 64: clients past hello */
     int max_pending;               /* default 16: upgraded connections that have not sent hello */
-    int max_pending_per_address;   /* default 4: of those, from one peer address */
+    int max_pending_per_address;   /* default 4: of those, from one client address */
+    sl_net_prefix trusted_proxies[SL_TRUSTED_PROXY_MAX]; /* --trusted-proxy: peers whose X-Forwarded-For
+                                                            names the client (none by default) */
+    int trusted_proxy_count;
     int max_sessions;              /* default 32 */
     int grace_s;                   /* default 300 */
     int idle_release_s;            /* default 30: a session without clients this long lets go of its
@@ -245,7 +252,7 @@ typedef struct sl_record_job {
 struct sl_client {                  /* [service] */
     struct lws *wsi;
     int id;
-    char addr[64];                  /* peer address, numeric */
+    char addr[SL_CLIENT_ADDRESS_MAX]; /* client address, numeric (sl_ws_client_address) */
     sl_session *session;            /* NULL before hello */
     int hello_done;
     int pending;                    /* in server->pending: upgraded, no hello yet */
@@ -355,6 +362,7 @@ typedef struct sl_metrics {                  /* [lock] */
     uint64_t snapshots, bytes_sent, messages_in, errors_sent;
     uint64_t dataset_loads, dataset_cache_hits, dataset_load_failures;
     uint64_t refused_full, refused_address, pending_evicted;  /* WebSocket admission */
+    uint64_t forwarded_clients, forwarded_ignored, forwarded_malformed; /* X-Forwarded-For of upgrades */
     sl_histogram render_ms, encode_ms;
     sl_histogram load_ms, prepare_ms;        /* dataset loads (loader thread), technique prepares */
     uint64_t frames_by_backend[SL_METRIC_BACKENDS]; /* frames rendered, by sl_metric_backend_names */
@@ -563,6 +571,11 @@ char *sl_http_metrics(sl_server *srv);
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
 /* c no longer waits for hello (it said hello or closes); no-op when not pending. */
 void sl_ws_pending_leave(sl_server *srv, sl_client *c);
+/* ws_client_address.c: the client address of upgrade wsi (the peer, or behind a
+ * --trusted-proxy the address it forwards), canonical text in out (size >=
+ * SL_CLIENT_ADDRESS_MAX). count: 1 at the first look of an upgrade, which
+ * counts and logs a forwarded, ignored or malformed header. Service thread. */
+void sl_ws_client_address(sl_server *srv, struct lws *wsi, int count, char *out, size_t size);
 /* Serves until *interrupted; *drain (the first SIGTERM) starts draining, and
  * the loop ends once sl_sessions_drain_done says so. */
 void sl_ws_run(sl_server *srv, volatile sig_atomic_t *interrupted, volatile sig_atomic_t *drain);

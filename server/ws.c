@@ -13,8 +13,9 @@
  * (http_host.c); this file reads the headers.
  * Admission: --max-clients counts only clients past hello. A connection
  * between upgrade and hello is "pending": pending connections have their own
- * budget (--max-pending) and a cap per peer address
- * (--max-pending-per-address; an upgrade over it is refused), so connections
+ * budget (--max-pending) and a cap per client address
+ * (--max-pending-per-address; an upgrade over it is refused; the address is the
+ * peer's, or behind a --trusted-proxy the one it forwards: ws_client_address.c), so connections
  * that never say hello cannot lock real users out. When the budget is full a
  * new upgrade evicts the oldest pending connection (which has had the
  * longest to send hello), so a flood from many addresses delays nobody who
@@ -109,12 +110,6 @@ static int filter_http(sl_server *srv, struct lws *wsi)
     return 1;
 }
 
-static void peer_address(struct lws *wsi, char *out, size_t size)
-{
-    if (!lws_get_peer_simple(wsi, out, size))
-        snprintf(out, size, "?");
-}
-
 static int pending_from(const sl_server *srv, const char *addr)
 {
     int n = 0;
@@ -190,15 +185,15 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
             return 1;
         if (!origin_allowed(srv, wsi))
             return 1;
-        char addr[64];
-        peer_address(wsi, addr, sizeof addr);
+        char addr[SL_CLIENT_ADDRESS_MAX];
+        sl_ws_client_address(srv, wsi, 1, addr, sizeof addr);
         return admission_refused(srv, addr);
     }
     case LWS_CALLBACK_ESTABLISHED: {
         sl_client *c = calloc(1, sizeof *c);
         if (!c)
             return -1;
-        peer_address(wsi, c->addr, sizeof c->addr);
+        sl_ws_client_address(srv, wsi, 0, c->addr, sizeof c->addr);
         /* Checked again: another upgrade may have been established since the filter. */
         if (admission_refused(srv, c->addr)) {
             free(c);

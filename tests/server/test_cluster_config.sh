@@ -5,6 +5,10 @@
 # HAProxy must accept both that file and the loopback layout scripts/cluster starts.
 # Each compose node must run with the node id and agent port HAProxy expects, and
 # open the one shared PostgreSQL catalog of the compose `postgres` service.
+# Every node, in compose and under scripts/cluster, trusts X-Forwarded-For from the
+# balancer's address only (--trusted-proxy: compose's fixed HAProxy address, 127.0.0.1
+# for scripts/cluster) and keeps the default per-address cap; the balancer replaces any
+# client-sent X-Forwarded-For with its own and limits connections per source.
 # Containers cannot run here; this checks the files, not a running cluster
 # (tests/server/test_server_cluster.c does that).
 # Prints "N passed, N failed".
@@ -28,6 +32,24 @@ for n in $nodes; do
   check 'grep -q "\"--db\", \"postgresql://sightline@postgres:5432/sightline\"" <<<"$block"' "$n uses the shared PostgreSQL catalog"
   specs+=(--node "$n=$n:8080=${agent:-0}")
 done
+
+# The balancer's fixed address is what every node trusts, and nothing else.
+proxy_ip="$(sed -n '/^  haproxy:$/,/^[a-z]/p' "$compose" | grep -o 'ipv4_address: [0-9.]*' | grep -o '[0-9.]*$')"
+check '[ -n "$proxy_ip" ]' "the compose haproxy service has a fixed ipv4_address"
+check 'grep -q "subnet: ${proxy_ip%.*}.0/24" "$compose"' "haproxy's address $proxy_ip lies in the compose network's subnet"
+for n in $nodes; do
+  block="$(sed -n "/^  $n:\$/,/^  [a-z0-9]*:\$/p" "$compose" | sed '$d')"
+  check '[ "$(grep -o "\"--trusted-proxy\", \"[^\"]*\"" <<<"$block")" = "\"--trusted-proxy\", \"$proxy_ip\"" ]' \
+    "$n trusts exactly the balancer's address ($proxy_ip)"
+  check '! grep -q -- "--max-pending-per-address" <<<"$block"' "$n keeps the default --max-pending-per-address"
+done
+check 'grep -q -- "--trusted-proxy 127.0.0.1 " "$root/scripts/cluster"' "scripts/cluster's nodes trust the balancer at 127.0.0.1"
+check '! grep -q -- "--max-pending-per-address [0-9]" "$root/scripts/cluster"' "scripts/cluster keeps the default --max-pending-per-address"
+frontend="$(sed -n '/^frontend /,/^backend /p' "$root/docker/haproxy.cfg.template")"
+check 'grep -q "http-request del-header X-Forwarded-For" <<<"$frontend" && grep -q "option forwardfor" <<<"$frontend"' \
+  "the balancer replaces a client's X-Forwarded-For with its own"
+check 'grep -q "tcp-request connection track-sc0 src" <<<"$frontend" && grep -q "sc0_conn_cur gt 64" <<<"$frontend" && grep -q "sc0_conn_rate gt 300" <<<"$frontend"' \
+  "the balancer limits connections per source (64 open, 300 per 10 s)"
 
 # The catalog service, and no password written into the file.
 check 'grep -qE "^  postgres:\$" "$compose"' "compose.yaml has the postgres service the nodes name"

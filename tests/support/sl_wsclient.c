@@ -8,6 +8,7 @@
 #include "sl_wsclient.h"
 
 #include <errno.h>
+#include <arpa/inet.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -107,6 +108,35 @@ sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_
                                    const char *subprotocol, const char *origin, int timeout_ms, sl_wsclient **out,
                                    sl_err *err)
 {
+    return sl_wsclient_connect_from(NULL, host, port, host_header, path, subprotocol, origin, timeout_ms, out, err);
+}
+
+/* Binds fd to the numeric address source (port 0); 0, or -1. */
+static int bind_source(int fd, int family, const char *source)
+{
+    struct sockaddr_storage ss;
+    memset(&ss, 0, sizeof ss);
+    socklen_t len = 0;
+    if (family == AF_INET) {
+        struct sockaddr_in *a = (struct sockaddr_in *)&ss;
+        a->sin_family = AF_INET;
+        if (inet_pton(AF_INET, source, &a->sin_addr) != 1)
+            return -1;
+        len = sizeof *a;
+    } else {
+        struct sockaddr_in6 *a = (struct sockaddr_in6 *)&ss;
+        a->sin6_family = AF_INET6;
+        if (inet_pton(AF_INET6, source, &a->sin6_addr) != 1)
+            return -1;
+        len = sizeof *a;
+    }
+    return bind(fd, (struct sockaddr *)&ss, len);
+}
+
+sl_status sl_wsclient_connect_from(const char *source, const char *host, int port, const char *host_header,
+                                   const char *path, const char *subprotocol, const char *origin, int timeout_ms,
+                                   sl_wsclient **out, sl_err *err)
+{
     *out = NULL;
     sl_wsclient *c = calloc(1, sizeof *c);
     if (!c)
@@ -122,7 +152,8 @@ sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_
     }
     for (struct addrinfo *a = ai; a && c->fd < 0; a = a->ai_next) {
         c->fd = socket(a->ai_family, a->ai_socktype, a->ai_protocol);
-        if (c->fd >= 0 && connect(c->fd, a->ai_addr, a->ai_addrlen) != 0) {
+        if (c->fd >= 0 && ((source && bind_source(c->fd, a->ai_family, source) != 0) ||
+                           connect(c->fd, a->ai_addr, a->ai_addrlen) != 0)) {
             close(c->fd);
             c->fd = -1;
         }

@@ -31,6 +31,11 @@ sl_status sl_wsclient_connect(const char *host, int port, const char *path, cons
 sl_status sl_wsclient_connect_host(const char *host, int port, const char *host_header, const char *path,
                                    const char *subprotocol, const char *origin, int timeout_ms, sl_wsclient **out,
                                    sl_err *err);
+/* The same from local address source (numeric, NULL = any): tests that need distinct
+ * client addresses use other loopback addresses (127.0.0.2, ...). */
+sl_status sl_wsclient_connect_from(const char *source, const char *host, int port, const char *host_header,
+                                   const char *path, const char *subprotocol, const char *origin, int timeout_ms,
+                                   sl_wsclient **out, sl_err *err);
 void sl_wsclient_destroy(sl_wsclient *c);   /* closes; NULL is fine */
 
 sl_status sl_wsclient_send_text(sl_wsclient *c, const char *text, size_t len, sl_err *err);
