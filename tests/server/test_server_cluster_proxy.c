@@ -12,13 +12,15 @@
  *     with a forged X-Forwarded-For of its own: the node counts all of them as
  *     127.0.0.3 (its 4 pending, 60 refused), since the balancer replaces the header;
  *  3. meanwhile a client from 127.0.0.2 connects through the balancer, says hello and
- *     gets a frame within 1 s, while the 4 silent ones are still open (their hello
+ *     gets a frame while the 4 silent ones are still open (their hello
  *     timeout is 60 s, so it did not get in by waiting them out). Before the fix every
  *     connection came from HAProxy's address and this upgrade was refused;
  *  4. the edge: a source with 64 connections open at the balancer gets its 65th
  *     closed unanswered, while another source is served.
- * The scene is prepared by a first session before the flood, so the 1 s is network
- * and one 64x64 render, not a shader compile. Bounded; everything stopped on every path.
+ * The scene is prepared by a first session before the flood, so the printed time is
+ * network and one 64x64 render (28-30 ms here); the check is on the decision (served
+ * before any silent slot could time out), not on the machine's speed. Bounded;
+ * everything stopped on every path.
  */
 #include "sl_cluster.h"
 
@@ -224,7 +226,10 @@ int main(void)
         int framed = tclient_wait_frame(&good, 0, 0, 10000) == 0;
         double ms = sl_clock_ms() - t0;
         fprintf(stderr, "client from 127.0.0.2 during the flood: first frame %.0f ms after connecting\n", ms);
-        CHECK(framed && ms <= 1000, "the client from 127.0.0.2 got %s after %.0f ms (limit 1 s)",
+        /* The decision, not the speed: served while the silent ones still hold their slots
+         * (their hello timeout is 60 s), so well before a slot could have been freed. The
+         * time is printed; it was 28-30 ms here (the issue's 1 s is a measurement). */
+        CHECK(framed && ms < 30000, "the client from 127.0.0.2 got %s after %.0f ms (the silent ones time out at 60 s)",
               framed ? "its first frame" : "no frame", ms);
     }
     int open_now = 0;
