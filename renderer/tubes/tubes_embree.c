@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../core/sl_clock.h"
+#include "../core/sl_leak_check.h"
 #include "../core/sl_parallel.h"
 #include "tubes_embree.h"
 #include "tubes_sweep.h"
@@ -453,6 +454,9 @@ static sl_status build(sl_tubes_embree *e, float radius_or_scale, sl_err *err)
         rtcReleaseGeometry(g);
     }
     rtcCommitScene(e->scene);
+    /* The build started oneTBB's workers and its exit-time teardown; the
+     * sanitizer's leak check must run before that teardown (sl_leak_check.h). */
+    sl_leak_check_early();
     pthread_mutex_lock(&e->error_lock);
     int failed = e->error[0] != 0;
     char msg[256];

@@ -122,13 +122,22 @@ async function observeOnce(obs, session, token) {
 }
 
 // Polls the server's state until pred(state) holds (then returns it) or
-// `ms` pass (then returns null and the last state is printed).
+// `ms` pass (then returns null and the last state is printed). With
+// sess.page, it also waits until that page has received the state patches up
+// to the matched version: the page's editors show the echo of what they sent,
+// so the next click acts on what the server holds (patches to a client are
+// written between frames, which lag on a busy machine), not on an older echo.
 async function serverStateWhere(obs, sess, pred, what, ms = 15000) {
   const deadline = Date.now() + ms;
   let st = null;
   for (;;) {
     st = await observeOnce(obs, sess.session, sess.token);
-    if (pred(st)) return st;
+    if (pred(st)) {
+      if (sess.page && !sess.page.isClosed()) {
+        await sess.page.waitForFunction((v) => window.sightline.stateVersion >= v, st.version, { timeout: T });
+      }
+      return st;
+    }
     if (Date.now() > deadline) break;
     await new Promise((r) => setTimeout(r, 150));
   }
@@ -912,7 +921,8 @@ async function main() {
     check(magic === '89504e470d0a1a0a' && download.suggestedFilename().endsWith('.png'), `snapshot is a PNG (${magic})`);
     await page.fill('#view-name', 'browser view');
     const link0 = await page.inputValue('#share-link');
-    const sess = { session: decodeURIComponent(link0.match(/session=([^&]+)/)[1]), token: link0.match(/token=([0-9a-f]+)/)[1] };
+    const sess = { session: decodeURIComponent(link0.match(/session=([^&]+)/)[1]), token: link0.match(/token=([0-9a-f]+)/)[1],
+      page };
     const obs = await browser.newPage();
     await obs.goto(`http://127.0.0.1:${port}/healthz`);
     const saved = { name: 'browser view', state: await observeOnce(obs, sess.session, sess.token) };
