@@ -15,6 +15,7 @@
 import { Connection } from './protocol.js';
 import { CameraControl } from './camera.js';
 import { ParamControls } from './controls.js';
+import { HeldParams } from './held_params.js';
 import { ProgressOverlay } from './progress.js';
 import { FlightPanel } from './flight.js';
 
@@ -87,7 +88,9 @@ const camera = new CameraControl(canvas, (phase, cam) => {
 });
 
 $('params').addEventListener('submit', (e) => e.preventDefault());
+const held = new HeldParams();   // own edits not yet echoed (held_params.js)
 const params = new ParamControls($('params'), (name, value) => {
+  held.hold(name, value);
   conn.send({ type: 'set', params: { [name]: value } });
 });
 
@@ -167,8 +170,9 @@ function applyState(patch) {
   const techniqueChanged = patch.technique && patch.technique !== app.state?.technique;
   const datasetChanged = patch.dataset && patch.dataset !== app.state?.dataset;
   app.state = { ...(app.state || {}), ...patch };
+  if (techniqueChanged || datasetChanged || !isController()) held.release();
   if (techniqueChanged || datasetChanged || !params.inputs.size) buildParams();
-  else params.update(app.state.params);
+  else params.update(held.shown(app.state.params));
   // A dataset just loaded (new bounds) that the catalog had not described
   // yet (or described before it kept histograms): ask again, so its attribute
   // names and histogram reach the controls.
@@ -282,6 +286,7 @@ conn.addEventListener('message', (ev) => {
       app.techniques = msg.techniques || [];
       app.datasets = msg.datasets || [];
       app.state = null;
+      held.release();
       params.schemaKey = '';
       camera.configure(msg.camera_default, msg.limits.max_elevation);
       applyState(msg.state);
@@ -346,6 +351,10 @@ conn.addEventListener('message', (ev) => {
         break;
       }
       if (msg.code === 'load_failed') progress.hide();
+      if (held.size) {   // a refused set: show the server's values again
+        held.release();
+        if (app.state?.params) params.update(app.state.params);
+      }
       if (msg.field === 'dataset' || msg.field === 'technique') fillPickers();   // back to the session's pair
       setBanner(`${msg.code}: ${msg.message}${msg.field ? ` (${msg.field})` : ''}`);
       setTimeout(() => { if ($('banner').textContent.startsWith(msg.code)) setBanner(''); }, 4000);
