@@ -64,11 +64,17 @@ sl_status sl_host_frame_draw(sl_host_frame *f, sl_err *err)
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDisable(GL_BLEND);
+    if (f->premultiplied) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    } else {
+        glDisable(GL_BLEND);
+    }
     glDisable(GL_CULL_FACE);
     glBindVertexArray(f->vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
+    glDisable(GL_BLEND);
     glBindTextureUnit(0, 0);
     glBindTextureUnit(1, 0);
     return sl_gl_check_errors("host frame: draw", err);

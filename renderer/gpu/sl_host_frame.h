@@ -7,7 +7,8 @@
  * 0 = nothing hit), both with GL's bottom-up rows, then calls sl_host_frame_draw: two
  * texture uploads and one full-screen triangle that writes colour and gl_FragDepth where
  * depth > 0, depth test GREATER against what the target holds, so nearer GL geometry drawn
- * before stays in front. Multisampled targets get the value in every sample. Buffers and
+ * before stays in front; with `premultiplied` the colour is blended over the target instead
+ * (a transparent CPU frame over the background). Multisampled targets get the value in every sample. Buffers and
  * textures are (re)made when the size changes. Render thread only (GL).
  */
 #ifndef SL_HOST_FRAME_H
@@ -24,6 +25,8 @@ typedef struct sl_host_frame {
     int width, height;
     uint8_t *rgba;          /* owned: width * height * 4, rows bottom-up */
     float *depth;           /* owned: width * height, rows bottom-up */
+    int premultiplied;      /* 1: rgba is premultiplied colour blended over the target
+                             * (ONE, ONE_MINUS_SRC_ALPHA), as a translucent GL draw; 0: replaces it */
     GLuint color_tex, depth_tex, program, vao;
 } sl_host_frame;
 

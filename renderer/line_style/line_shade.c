@@ -41,11 +41,9 @@ void sl_line_shader_base(const sl_line_shader *sh, float scalar, float rgb[3])
         rgb[c] = ((1.0f - f) * sh->table[4 * i + c] + f * sh->table[4 * (i + 1) + c]) / 255.0f;
 }
 
-void sl_line_shader_color(const sl_line_shader *sh, float scalar, const float n_in[3], const float v[3],
-                          uint8_t rgba[4])
+void sl_line_shader_lit(const sl_line_shader *sh, const float base[3], const float n_in[3], const float v[3],
+                        float rgb[3])
 {
-    float base[3];
-    sl_line_shader_base(sh, scalar, base);
     float n[3] = {n_in[0], n_in[1], n_in[2]};
     float l[3] = {(float)sh->light[0], (float)sh->light[1], (float)sh->light[2]};
     if (n[0] * v[0] + n[1] * v[1] + n[2] * v[2] < 0.0f)
@@ -59,8 +57,17 @@ void sl_line_shader_color(const sl_line_shader *sh, float scalar, const float n_
         spec = powf(fmaxf((n[0] * h[0] + n[1] * h[1] + n[2] * h[2]) / hl, 0.0f), sh->material[3]);
     for (int c = 0; c < 3; c++) {
         float value = base[c] * (sh->material[0] + sh->material[1] * diff) + sh->material[2] * spec;
-        value = fminf(fmaxf(value, 0.0f), 1.0f);
-        rgba[c] = (uint8_t)lrintf(value * 255.0f);
+        rgb[c] = fminf(fmaxf(value, 0.0f), 1.0f);
     }
+}
+
+void sl_line_shader_color(const sl_line_shader *sh, float scalar, const float n[3], const float v[3],
+                          uint8_t rgba[4])
+{
+    float base[3], rgb[3];
+    sl_line_shader_base(sh, scalar, base);
+    sl_line_shader_lit(sh, base, n, v, rgb);
+    for (int c = 0; c < 3; c++)
+        rgba[c] = (uint8_t)lrintf(rgb[c] * 255.0f);
     rgba[3] = 255;
 }

@@ -33,6 +33,11 @@ void sl_line_shader_init(sl_line_shader *sh, const sl_line_style *style, const s
 /* The colormap's colour of `scalar` (0..1 per channel), as colormap.glsl samples it. */
 void sl_line_shader_base(const sl_line_shader *sh, float scalar, float rgb[3]);
 
+/* sl_shade of lighting.glsl, clamped to 0..1 (before rounding): base the unlit colour, n the
+ * unit surface normal, v the unit direction towards the eye. */
+void sl_line_shader_lit(const sl_line_shader *sh, const float base[3], const float n[3], const float v[3],
+                        float rgb[3]);
+
 /* The shaded colour: n the unit surface normal, v the unit direction towards the eye. */
 void sl_line_shader_color(const sl_line_shader *sh, float scalar, const float n[3], const float v[3],
                           uint8_t rgba[4]);

@@ -19,7 +19,12 @@
  * resolution, quantization and the per-voxel cap re-prepare. Data radii are
  * not used (one radius for all tubes). Lines dropped by the per-voxel cap
  * are reported once per build on stderr and in every frame's
- * sl_render_stats.dropped. Work counters for tests: voxel_lines.h. Render thread only.
+ * sl_render_stats.dropped. Two executions of the one model (`backend`, the
+ * rule of core/sl_backend.h: cpu on a software GL device): gl, the fragment
+ * pass; cpu, voxel_cast_cpu.c, the same walk in C on every core into an
+ * sl_host_frame blended into the target as the pass's output is (the
+ * density and AO passes stay on GL and are read back once per change).
+ * Work counters for tests: voxel_lines.h. Render thread only.
  * Limits: README.md.
  */
 #include <math.h>
@@ -28,24 +33,37 @@
 #include <string.h>
 
 #include "../line_style/sl_line_style.h"
+#include "../core/sl_backend.h"
 #include "../core/sl_clock.h"
 #include "../core/sl_technique.h"
 #include "../data/sl_dataset.h"
 #include "../gpu/sl_gpu.h"
 #include "../lines/sl_line_gpu.h"
+#include "../gpu/sl_host_frame.h"
+#include "../line_style/sl_line_shade.h"
+#include "voxel_cast_cpu.h"
 #include "voxel_gpu.h"
 #include "voxel_grid.h"
 #include "voxel_lines.h"
 #include "voxel_lod.h"
+#include "voxel_occupancy.h"
 
 static const char *const quant_choices[] = {"2", "4", "8", "16", "32", "64", "128", "256", NULL};
 static const char *const neighbor_choices[] = {"auto", "own", "always", NULL};
 static const char *const build_choices[] = {"auto", "cpu", "gpu", NULL};
 static const char *const shadow_choices[] = {"soft", "lines", NULL};
 static const char *const opacity_tf_choices[] = {"constant", "ramp", NULL};
+static const char *const backend_choices[] = {"auto", "gl", "cpu", NULL};
+
+/* The CPU execution for the backend rule (core/sl_backend.h): always built. */
+static void voxel_lines_backend_cpu(sl_backend_cpu *out)
+{
+    *out = (sl_backend_cpu){.name = "cpu", .built = 1, .missing = ""};
+}
 
 static const sl_param_def voxel_lines_params[] = {
     SL_LINE_STYLE_PARAMS,
+    SL_BACKEND_PARAM(backend_choices, "cpu"),
     {"opacity", SL_PARAM_FLOAT, 0.0, 1.0, {1.0}, NULL, "", "per-line opacity; 1 = opaque (first hit ends the ray)",
      SL_INVALIDATE_FRAME},
     {"opacity_transfer", SL_PARAM_ENUM, 0, 0, {0}, opacity_tf_choices, "",
@@ -107,6 +125,14 @@ typedef struct voxel_lines_state {
     int density_levels;
     int density_valid;          /* level 0 holds the weighted density of density_key */
     float density_key[3];       /* opacity ramp on, colormap t of bytes 0 and 255 (0, 0 when off) */
+    sl_voxel_occupancy occupancy; /* the pyramid behind occupancy_tex */
+    sl_backend backend;         /* the execution chosen at prepare */
+    sl_voxel_cast_model cpu;    /* backend cpu: the decoded model, density and AO copies */
+    float *reps_host;           /* backend cpu: the representative lines (reps_buf's floats) */
+    sl_host_frame host;         /* backend cpu: the cast frame on its way into the target */
+    sl_voxel_cast_stats cast;   /* backend cpu: the last frame's work */
+    int cpu_density_valid;      /* backend cpu: cpu.density holds density_tex's levels */
+    int cpu_ao_valid;           /* backend cpu: cpu.ao holds ao_tex */
 } voxel_lines_state;
 
 static void release_grid(voxel_lines_state *s)
@@ -121,6 +147,10 @@ static void release_grid(voxel_lines_state *s)
     s->offsets_buf = s->counts_buf = s->lines_buf = s->density_tex = s->ao_tex = s->occupancy_tex = 0;
     s->reps_buf = 0;
     s->rep_levels = 0;
+    sl_voxel_cast_model_deinit(&s->cpu);
+    sl_voxel_occupancy_deinit(&s->occupancy);
+    free(s->reps_host);
+    s->reps_host = NULL;
     s->ao_valid = 0;
     s->density_valid = 0;
     s->ready = 0;
@@ -138,6 +168,7 @@ static void voxel_lines_release(void *opaque)
     if (s->vao) glDeleteVertexArrays(1, &s->vao);
     if (s->camera_ubo) glDeleteBuffers(1, &s->camera_ubo);
     sl_line_colors_deinit(&s->colors);
+    sl_host_frame_deinit(&s->host);
     free(s);
 }
 
@@ -157,68 +188,26 @@ static GLuint make_buffer(const void *data, size_t bytes)
     return b;
 }
 
-/* The occupancy pyramid for empty-space skipping: level 0 is 1 where a voxel
- * within 2 (Chebyshev) holds lines — so tubes of radius <= 2 voxels and the
- * neighbour search never reach a 0 voxel — and level L is the max over 2^3
- * cells of level L-1. Computed on the CPU from the counts (separable max). */
+/* The occupancy pyramid for empty-space skipping (voxel_occupancy.h): built
+ * on the CPU from the counts, kept for the CPU execution, uploaded as an
+ * R8UI 3D texture with one mip level per pyramid level. */
 static sl_status upload_occupancy(voxel_lines_state *s, const uint8_t *counts, sl_err *err)
 {
-    const int *dm = s->frame.dims;
-    size_t n = s->voxel_count;
-    uint8_t *a = malloc(n), *b = malloc(n);
-    if (!a || !b) {
-        free(a);
-        free(b);
-        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines: out of memory for the occupancy of %zu voxels", n);
-    }
-    for (size_t v = 0; v < n; v++)
-        a[v] = counts[v] != 0;
-    size_t stride[3] = {1, (size_t)dm[0], (size_t)dm[0] * dm[1]};
-    for (int ax = 0; ax < 3; ax++) {
-        for (size_t v = 0; v < n; v++) {
-            int c = (int)(v / stride[ax] % (size_t)dm[ax]);
-            uint8_t m = 0;
-            for (int k = -2; k <= 2; k++)
-                if (c + k >= 0 && c + k < dm[ax])
-                    m |= a[(size_t)((ptrdiff_t)v + (ptrdiff_t)k * (ptrdiff_t)stride[ax])];
-            b[v] = m;
-        }
-        uint8_t *t = a; a = b; b = t;
-    }
-    /* Up to 4 levels (blocks of 8^3), but no more than the texture can have:
-     * floor(log2(largest side)) + 1 (a grid of 4 + 2 padding has 3). */
-    int maxdim = dm[0] > dm[1] ? dm[0] : dm[1];
-    maxdim = maxdim > dm[2] ? maxdim : dm[2];
-    s->occupancy_levels = 1;
-    while (s->occupancy_levels < 4 && (1 << s->occupancy_levels) <= maxdim)
-        s->occupancy_levels++;
+    sl_voxel_occupancy_deinit(&s->occupancy);
+    sl_status st = sl_voxel_occupancy_build(s->frame.dims, counts, &s->occupancy, err);
+    if (st != SL_OK)
+        return st;
+    const sl_voxel_occupancy *o = &s->occupancy;
+    s->occupancy_levels = o->levels;
     glCreateTextures(GL_TEXTURE_3D, 1, &s->occupancy_tex);
-    glTextureStorage3D(s->occupancy_tex, s->occupancy_levels, GL_R8UI, dm[0], dm[1], dm[2]);
+    glTextureStorage3D(s->occupancy_tex, o->levels, GL_R8UI, o->dims[0][0], o->dims[0][1], o->dims[0][2]);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    int w[3] = {dm[0], dm[1], dm[2]};
-    for (int level = 0; level < s->occupancy_levels; level++) {
-        glTextureSubImage3D(s->occupancy_tex, level, 0, 0, 0, w[0], w[1], w[2], GL_RED_INTEGER, GL_UNSIGNED_BYTE, a);
-        /* Level sizes follow GL: max(1, floor(w / 2)); cells beyond are folded in by the max. */
-        int gw[3];
-        for (int c = 0; c < 3; c++)
-            gw[c] = w[c] / 2 > 1 ? w[c] / 2 : 1;
-        memset(b, 0, (size_t)gw[0] * gw[1] * gw[2]);
-        for (int z = 0; z < w[2]; z++)
-            for (int y = 0; y < w[1]; y++)
-                for (int x = 0; x < w[0]; x++) {
-                    int X = x / 2 < gw[0] ? x / 2 : gw[0] - 1, Y = y / 2 < gw[1] ? y / 2 : gw[1] - 1,
-                        Z = z / 2 < gw[2] ? z / 2 : gw[2] - 1;
-                    b[(size_t)X + (size_t)gw[0] * ((size_t)Y + (size_t)gw[1] * Z)] |=
-                        a[(size_t)x + (size_t)w[0] * ((size_t)y + (size_t)w[1] * z)];
-                }
-        uint8_t *t = a; a = b; b = t;
-        memcpy(w, gw, sizeof w);
-    }
+    for (int level = 0; level < o->levels; level++)
+        glTextureSubImage3D(s->occupancy_tex, level, 0, 0, 0, o->dims[level][0], o->dims[level][1],
+                            o->dims[level][2], GL_RED_INTEGER, GL_UNSIGNED_BYTE, o->level[level]);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTextureParameteri(s->occupancy_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
     glTextureParameteri(s->occupancy_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    free(a);
-    free(b);
     return SL_OK;
 }
 
@@ -247,7 +236,10 @@ static sl_status upload_representatives(voxel_lines_state *s, const sl_voxel_gri
     s->rep_levels = lod.levels;
     s->reps_buf = make_buffer(all, total * sizeof *all);
     s->grid_bytes += total * sizeof *all;
-    free(all);
+    if (s->backend == SL_BACKEND_CPU)
+        s->reps_host = all;
+    else
+        free(all);
     sl_voxel_lod_deinit(&lod);
     return SL_OK;
 }
@@ -353,6 +345,8 @@ static sl_status build_and_upload(voxel_lines_state *s, int attribute, sl_err *e
     s->prep.upload_ms = t_reps - t_upload;
     if (st == SL_OK)
         st = upload_representatives(s, &g, err); /* mostly the CPU LoD build */
+    if (st == SL_OK && s->backend == SL_BACKEND_CPU)
+        st = sl_voxel_cast_model_build(&s->cpu, &g, err);
     s->prep.preprocess_ms += sl_clock_ms() - t_reps;
     s->ready = st == SL_OK;
     if (st == SL_OK && g.dropped_overflow)
@@ -400,8 +394,16 @@ static sl_status voxel_lines_prepare(sl_gpu *gpu, const sl_dataset *ds, const sl
         return st;
     }
     s->padding = padding_for((float)(style.radius / probe.h));
+    sl_backend_cpu cpu;
+    voxel_lines_backend_cpu(&cpu);
+    st = sl_backend_decide("voxel_lines", sl_params_choice(params, "backend"), sl_gpu_is_software(gpu), &cpu,
+                           &s->backend, err);
+    if (st != SL_OK) {
+        free(s);
+        return st;
+    }
     st = build_and_upload(s, style.attribute, err);
-    if (st == SL_OK)
+    if (st == SL_OK && s->backend == SL_BACKEND_GL) /* the cpu backend casts on the CPU */
         st = sl_gl_program_create(&(sl_program_desc){.vertex = "gpu/glsl/fullscreen_triangle.vert.glsl",
                                                      .fragment = "voxel_lines/voxel_lines.frag.glsl",
                                                      .label = "voxel_lines"},
@@ -461,7 +463,41 @@ static sl_status compute_ao(voxel_lines_state *s, float extinction, int rays, fl
     sl_status st = dispatch_cells(s->ao_dims, "ambient occlusion", err);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     counters.ao_passes++;
+    s->cpu_ao_valid = 0;
     return st;
+}
+
+/* Backend cpu: copies of the density chain and the AO field the GL passes computed. */
+static sl_status read_back_density(voxel_lines_state *s, sl_err *err)
+{
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    for (int level = 0; level < s->density_levels && level < SL_VOXEL_CAST_MAX_LEVELS; level++) {
+        int d[3];
+        glGetTextureLevelParameteriv(s->density_tex, level, GL_TEXTURE_WIDTH, &d[0]);
+        glGetTextureLevelParameteriv(s->density_tex, level, GL_TEXTURE_HEIGHT, &d[1]);
+        glGetTextureLevelParameteriv(s->density_tex, level, GL_TEXTURE_DEPTH, &d[2]);
+        float *dst = sl_voxel_cast_density_level(&s->cpu, level, d, err);
+        if (!dst)
+            return err ? err->status : SL_ERR_NOMEM;
+        glGetTextureImage(s->density_tex, level, GL_RED, GL_FLOAT, (GLsizei)((size_t)d[0] * d[1] * d[2] * sizeof(float)),
+                          dst);
+    }
+    s->cpu_density_valid = 1;
+    return sl_gl_check_errors("voxel_lines (cpu): reading the density back", err);
+}
+
+static sl_status read_back_ao(voxel_lines_state *s, sl_err *err)
+{
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    uint8_t *dst = sl_voxel_cast_ao(&s->cpu, s->ao_dims, err);
+    if (!dst)
+        return err ? err->status : SL_ERR_NOMEM;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTextureImage(s->ao_tex, 0, GL_RED, GL_UNSIGNED_BYTE,
+                      (GLsizei)((size_t)s->ao_dims[0] * s->ao_dims[1] * s->ao_dims[2]), dst);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    s->cpu_ao_valid = 1;
+    return sl_gl_check_errors("voxel_lines (cpu): reading the AO field back", err);
 }
 
 /* Level 0 of the density texture from the uploaded lines, each weighted by
@@ -485,6 +521,7 @@ static sl_status update_density(voxel_lines_state *s, const float key[3], sl_err
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     glGenerateTextureMipmap(s->density_tex);
     counters.density_passes++;
+    s->cpu_density_valid = 0;
     if (st == SL_OK) {
         memcpy(s->density_key, key, sizeof s->density_key);
         s->density_valid = 1;
@@ -555,13 +592,54 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     if (neighbors)
         neighbors = radius_g > 1.0f ? (radius_g > 2.0f ? 2 : (int)ceilf(radius_g)) : 1;
 
+    /* Opaque lines end the ray at the first hit (alpha reaches 1); with the
+     * ramp they are translucent even at opacity 1, so the threshold applies. */
+    float alpha_stop = opacity >= 1.0f && !ramp ? 1.0f : (float)sl_params_float(params, "alpha_threshold");
+    int skip_levels = sl_params_bool(params, "empty_space_skipping") ? s->occupancy_levels - 1 : -1;
+    int rep_level = sl_params_int(params, "shadow_lod");
+    rep_level = rep_level < 1 ? 1 : (rep_level >= s->rep_levels ? s->rep_levels - 1 : rep_level);
+    int shadow_lines = shadows && sl_params_choice(params, "shadow_mode") == 1 && rep_level >= 1;
+    sl_backend_cpu cpu;
+    voxel_lines_backend_cpu(&cpu);
+    stats->backend = sl_backend_name(s->backend, &cpu);
+    stats->primitives = (double)view->width * view->height;
+    stats->dropped = (double)s->dropped_overflow;
+    const sl_dataset *ds = s->dataset;
+    sl_vec3 eye = sl_v3_sub(view->camera.eye, ds->origin);
+    float eye_g[3] = {(float)((eye.x - s->frame.lo[0]) / h), (float)((eye.y - s->frame.lo[1]) / h),
+                      (float)((eye.z - s->frame.lo[2]) / h)};
+    if (s->backend == SL_BACKEND_CPU) {
+        if (((shadows && !shadow_lines) || ao) && !s->cpu_density_valid && (st = read_back_density(s, err)) != SL_OK)
+            return st;
+        if (ao && !s->cpu_ao_valid && (st = read_back_ao(s, err)) != SL_OK)
+            return st;
+        sl_line_shader shader;
+        sl_line_shader_init(&shader, &style, view);
+        shader.range[0] = 0.0f; /* the shader's colormap takes t (attribute byte through attr_range) */
+        shader.range[1] = 1.0f;
+        sl_voxel_cast_params cp = {
+            .eye_g = {eye_g[0], eye_g[1], eye_g[2]}, .inv_h = (float)(1.0 / h), .radius_g = radius_g,
+            .opacity = opacity, .alpha_stop = alpha_stop, .neighbors = neighbors,
+            .opacity_by_distance = sl_params_bool(params, "opacity_by_distance"), .opacity_ramp = ramp,
+            .attr_range = {attr_range[0], attr_range[1]}, .skip_levels = skip_levels, .occupancy = &s->occupancy,
+            .extinction = extinction, .shadows = shadows, .shadow_lines = shadow_lines, .ao_on = ao,
+            .shadow_strength = (float)sl_params_float(params, "shadow_strength"),
+            .shadow_lod = (float)sl_params_int(params, "shadow_lod"), .max_lod = (float)(s->density_levels - 1),
+            .ao_strength = (float)sl_params_float(params, "ao_strength"),
+            .reps = shadow_lines && s->reps_host ? s->reps_host + s->rep_base[rep_level] : NULL,
+            .rep_dims = {s->rep_dims[rep_level][0], s->rep_dims[rep_level][1], s->rep_dims[rep_level][2]},
+            .rep_scale = (float)(1 << rep_level), .shader = &shader};
+        if ((st = sl_host_frame_resize(&s->host, view->width, view->height, err)) != SL_OK ||
+            (st = sl_voxel_cast_render(&s->cpu, &cp, view, &s->host, &s->cast, err)) != SL_OK)
+            return st;
+        counters.cpu_frames++;
+        return sl_host_frame_draw(&s->host, err);
+    }
+
     sl_camera_ubo_update(&s->camera_ubo, view);
     GLuint p = s->program;
     glUseProgram(p);
-    const sl_dataset *ds = s->dataset;
-    sl_vec3 eye = sl_v3_sub(view->camera.eye, ds->origin);
-    glUniform3f(glGetUniformLocation(p, "u_eye_g"), (float)((eye.x - s->frame.lo[0]) / h),
-                (float)((eye.y - s->frame.lo[1]) / h), (float)((eye.z - s->frame.lo[2]) / h));
+    glUniform3f(glGetUniformLocation(p, "u_eye_g"), eye_g[0], eye_g[1], eye_g[2]);
     glUniform3i(glGetUniformLocation(p, "u_dims"), s->frame.dims[0], s->frame.dims[1], s->frame.dims[2]);
     set1i(p, "u_quant", s->quant);
     set1i(p, "u_quant_bits", s->quant_bits);
@@ -569,9 +647,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     set1f(p, "u_inv_h", (float)(1.0 / h));
     set1f(p, "u_radius_g", radius_g);
     set1f(p, "u_opacity", opacity);
-    /* Opaque lines end the ray at the first hit (alpha reaches 1); with the
-     * ramp they are translucent even at opacity 1, so the threshold applies. */
-    set1f(p, "u_alpha_stop", opacity >= 1.0f && !ramp ? 1.0f : (float)sl_params_float(params, "alpha_threshold"));
+    set1f(p, "u_alpha_stop", alpha_stop);
     set1i(p, "u_neighbors", neighbors);
     set1i(p, "u_opacity_by_distance", sl_params_bool(params, "opacity_by_distance"));
     sl_line_style_uniforms(p, &style, 0);
@@ -580,16 +656,14 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     set1i(p, "u_density", 1);
     set1i(p, "u_ao", 2);
     set1i(p, "u_occupancy", 3);
-    set1i(p, "u_skip_levels", sl_params_bool(params, "empty_space_skipping") ? s->occupancy_levels - 1 : -1);
+    set1i(p, "u_skip_levels", skip_levels);
     set1f(p, "u_extinction", extinction);
     set1i(p, "u_shadows", shadows);
     set1f(p, "u_shadow_strength", (float)sl_params_float(params, "shadow_strength"));
     set1f(p, "u_shadow_lod", (float)sl_params_int(params, "shadow_lod"));
     set1f(p, "u_max_lod", (float)(s->density_levels - 1));
     set1i(p, "u_ao_on", ao);
-    int rep_level = sl_params_int(params, "shadow_lod");
-    rep_level = rep_level < 1 ? 1 : (rep_level >= s->rep_levels ? s->rep_levels - 1 : rep_level);
-    set1i(p, "u_shadow_lines", shadows && sl_params_choice(params, "shadow_mode") == 1 && rep_level >= 1);
+    set1i(p, "u_shadow_lines", shadow_lines);
     glUniform3i(glGetUniformLocation(p, "u_rep_dims"), s->rep_dims[rep_level][0], s->rep_dims[rep_level][1],
                 s->rep_dims[rep_level][2]);
     set1i(p, "u_rep_base", s->rep_base[rep_level]);
@@ -613,8 +687,6 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glDisable(GL_BLEND);
-    stats->primitives = (double)view->width * view->height;
-    stats->dropped = (double)s->dropped_overflow;
     return SL_OK;
 }
 
@@ -641,4 +713,5 @@ const sl_technique sl_voxel_lines_technique = {
     .release = voxel_lines_release,
     .gpu_bytes = voxel_lines_gpu_bytes,
     .prepare_stats = voxel_lines_prepare_stats,
+    .backend_cpu = voxel_lines_backend_cpu,
 };
