@@ -45,13 +45,7 @@ static int error_is(cJSON *j, const char *code, const char *field)
 /* The connection still answers: ping -> pong with the same seq. */
 static int still_usable(tclient *c, int seq)
 {
-    if (tclient_send(c, "{\"type\":\"ping\",\"seq\":%d}", seq))
-        return 0;
-    cJSON *p = tclient_wait_type(c, "pong", T);
-    const cJSON *s = cJSON_GetObjectItemCaseSensitive(p, "seq");
-    int ok = p && cJSON_IsNumber(s) && s->valueint == seq;
-    cJSON_Delete(p);
-    return ok;
+    return tclient_ping(c, seq, T);
 }
 
 static int http_get(int port, const char *path, char *out, size_t out_size)
