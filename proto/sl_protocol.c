@@ -597,6 +597,11 @@ char *sl_msg_progress_text(const sl_msg_progress *p)
 
 char *sl_msg_error_text(const char *code, const char *message, const char *field)
 {
+    return sl_msg_error_repeat_text(code, message, field, 0);
+}
+
+char *sl_msg_error_repeat_text(const char *code, const char *message, const char *field, uint32_t repeated)
+{
     cJSON *o = cJSON_CreateObject();
     if (!o)
         return NULL;
@@ -604,6 +609,8 @@ char *sl_msg_error_text(const char *code, const char *message, const char *field
     cJSON_AddStringToObject(o, "code", code ? code : "error");
     cJSON_AddStringToObject(o, "message", message ? message : "");
     cJSON_AddStringToObject(o, "field", field ? field : "");
+    if (repeated > 0)
+        cJSON_AddNumberToObject(o, "repeated", repeated);
     char *text = cJSON_PrintUnformatted(o);
     cJSON_Delete(o);
     return text;

@@ -141,6 +141,9 @@ const char *sl_camera_phase_name(sl_camera_phase phase);
 
 /* {"type":"error","code":code,"message":message,"field":field}; field may be NULL or "". */
 char *sl_msg_error_text(const char *code, const char *message, const char *field);
+/* The same with "repeated":repeated when repeated > 0: that many more errors
+ * of this code and field were merged into this one (message: the newest's). */
+char *sl_msg_error_repeat_text(const char *code, const char *message, const char *field, uint32_t repeated);
 
 /* A session's stream settings (the `stream` object of `set` and state).
  * While dragging, the server picks the scale: with interactive_adaptive the

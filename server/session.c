@@ -63,26 +63,77 @@ static uint8_t *lws_text_buffer(char *text, size_t *len)
     return buf;
 }
 
+void sl_client_close(sl_client *c, int code, const char *reason, int after_replies)
+{
+    if (c->close_code)
+        return;
+    c->close_code = code;
+    c->close_after_replies = after_replies;
+    snprintf(c->close_reason, sizeof c->close_reason, "%s", reason);
+    lws_set_timeout(c->wsi, PENDING_TIMEOUT_CLOSE_SEND, SL_CLOSE_GRACE_S);
+    lws_callback_on_writable(c->wsi);
+}
+
+/* The next free slot of c's reply ring, or NULL when the reply budget is
+ * used up (the link is then told to close) or c is closing anyway. */
+static sl_reply *reply_slot(sl_client *c)
+{
+    if (c->close_code)
+        return NULL;
+    if (c->reply_count >= SL_CLIENT_MAX_TEXT) {
+        char reason[80];
+        snprintf(reason, sizeof reason, "reply budget: %d replies not read", SL_CLIENT_MAX_TEXT);
+        sl_client_close(c, LWS_CLOSE_STATUS_POLICY_VIOLATION, reason, 0);
+        return NULL;
+    }
+    sl_reply *r = &c->replies[(c->reply_head + c->reply_count) % SL_CLIENT_MAX_TEXT];
+    memset(r, 0, sizeof *r);
+    c->reply_count++;
+    lws_callback_on_writable(c->wsi);
+    return r;
+}
+
 int sl_client_queue_text(sl_client *c, char *text)
 {
-    if (!text)
-        return -1;
-    if (c->text_count >= SL_CLIENT_MAX_TEXT) {
-        free(text);
-        c->close_after_send = 1;
-        lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"reply queue full", 16);
-        lws_set_timeout(c->wsi, PENDING_TIMEOUT_CLOSE_SEND, LWS_TO_KILL_ASYNC);
+    if (!text) {
+        sl_client_close(c, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory", 0);
         return -1;
     }
-    size_t len;
-    uint8_t *buf = lws_text_buffer(text, &len);
-    if (!buf)
+    sl_reply *r = reply_slot(c);
+    if (!r) {
+        free(text);
         return -1;
-    int slot = (c->text_head + c->text_count) % SL_CLIENT_MAX_TEXT;
-    c->text[slot] = buf;
-    c->text_len[slot] = len;
-    c->text_count++;
-    lws_callback_on_writable(c->wsi);
+    }
+    r->text = text;
+    return 0;
+}
+
+int sl_client_queue_error(sl_client *c, const char *code, const char *message, const char *field)
+{
+    if (!field)
+        field = "";
+    char *text = strdup(message ? message : "");
+    if (!text) {
+        sl_client_close(c, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory", 0);
+        return -1;
+    }
+    for (int i = 0; i < c->reply_count; i++) {
+        sl_reply *q = &c->replies[(c->reply_head + i) % SL_CLIENT_MAX_TEXT];
+        if (q->code[0] && strcmp(q->code, code) == 0 && strncmp(q->field, field, sizeof q->field - 1) == 0) {
+            free(q->text);
+            q->text = text;
+            q->repeated++;
+            return 0;
+        }
+    }
+    sl_reply *r = reply_slot(c);
+    if (!r) {
+        free(text);
+        return -1;
+    }
+    r->text = text;
+    snprintf(r->code, sizeof r->code, "%s", code);
+    snprintf(r->field, sizeof r->field, "%s", field);
     return 0;
 }
 
@@ -98,7 +149,14 @@ static void send_error(sl_server *srv, sl_client *c, const char *code, const cha
     pthread_mutex_lock(&srv->lock);
     srv->metrics.errors_sent++;
     pthread_mutex_unlock(&srv->lock);
-    sl_client_queue_text(c, sl_msg_error_text(code, message, field));
+    sl_client_queue_error(c, code, message, field);
+}
+
+/* An error in or before hello: the link ends after it, with 1008 and the code as reason. */
+static void refuse(sl_server *srv, sl_client *c, const char *code, const char *message, const char *field)
+{
+    send_error(srv, c, code, message, field);
+    sl_client_close(c, LWS_CLOSE_STATUS_POLICY_VIOLATION, code, 1);
 }
 
 cJSON *sl_session_state_json(const sl_session *s)
@@ -368,6 +426,7 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     pthread_mutex_unlock(&srv->lock);
     c->play_seq = s->play ? s->play_seq - 1 : s->play_seq; /* a path playing is news; a stopped one is not */
     lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
+    lws_set_timer_usecs(c->wsi, LWS_SET_TIMER_USEC_CANCEL); /* the hello timeout (ws.c) */
     sl_msg_welcome w = {.session = s->id, .token = s->token, .node = srv->cfg.node_id, .client = c->id,
                         .is_controller = s->controller == c->id, .state = sl_session_state_json(s),
                         .techniques = cJSON_Duplicate(srv->techniques_json, 1),
@@ -581,8 +640,7 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
 static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     if (m->version != SL_PROTO_VERSION) {
-        send_error(srv, c, "bad_version", "this server speaks protocol version 1", "version");
-        c->close_after_send = 1;
+        refuse(srv, c, "bad_version", "this server speaks protocol version 1", "version");
         return;
     }
     if (srv->client_count >= srv->cfg.max_clients) {
@@ -590,8 +648,7 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
         char msg[120];
         snprintf(msg, sizeof msg, "the server already has %d clients (--max-clients); retry later",
                  srv->cfg.max_clients);
-        send_error(srv, c, "full", msg, "");
-        c->close_after_send = 1;
+        refuse(srv, c, "full", msg, "");
         pthread_mutex_lock(&srv->lock);
         srv->metrics.refused_full++;
         pthread_mutex_unlock(&srv->lock);
@@ -603,9 +660,8 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
     sl_session *s = m->session[0] ? find_session(srv, m->session) : NULL;
     if (!s && draining) {
         /* New and restored sessions belong on another node; the client reconnects through the balancer. */
-        send_error(srv, c, "draining",
-                   "this node is shutting down and takes no new sessions; reconnect to reach another node", "");
-        c->close_after_send = 1;
+        refuse(srv, c, "draining",
+               "this node is shutting down and takes no new sessions; reconnect to reach another node", "");
         return;
     }
     if (m->session[0] && !s) {
@@ -613,9 +669,8 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
         sl_err err = {0};
         s = restore_session(srv, m, &code, &err);
         if (!s) {
-            send_error(srv, c, code, err.message, strcmp(code, "bad_token") == 0 ? "token"
+            refuse(srv, c, code, err.message, strcmp(code, "bad_token") == 0 ? "token"
                                                   : strcmp(code, "unknown_session") == 0 ? "session" : "");
-            c->close_after_send = 1;
             return;
         }
     } else if (s) {
@@ -625,16 +680,14 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
         for (size_t i = 0; i < lt; i++)
             diff |= (unsigned)(s->token[i] ^ (i < lm ? m->token[i] : 0));
         if (diff) {
-            send_error(srv, c, "bad_token", "the join token does not match this session", "token");
-            c->close_after_send = 1;
+            refuse(srv, c, "bad_token", "the join token does not match this session", "token");
             return;
         }
     } else {
         sl_err err = {0};
         s = create_session(srv, m->width, m->height, &err);
         if (!s) {
-            send_error(srv, c, "session_failed", err.message, "");
-            c->close_after_send = 1;
+            refuse(srv, c, "session_failed", err.message, "");
             return;
         }
     }
@@ -818,14 +871,14 @@ void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t 
     srv->metrics.messages_in++;
     pthread_mutex_unlock(&srv->lock);
     if (sl_msg_parse(text, len, &m, code, field, &err) != SL_OK) {
-        send_error(srv, c, code, err.message, field);
-        if (!c->hello_done)
-            c->close_after_send = 1;
+        if (c->hello_done)
+            send_error(srv, c, code, err.message, field);
+        else
+            refuse(srv, c, code, err.message, field);
         return;
     }
     if (!c->hello_done && m.type != SL_MSG_HELLO) {
-        send_error(srv, c, "hello_required", "the first message must be hello", "type");
-        c->close_after_send = 1;
+        refuse(srv, c, "hello_required", "the first message must be hello", "type");
         sl_msg_deinit(&m);
         return;
     }
@@ -994,9 +1047,9 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
                 s->snap_req[i] = 0;
         pthread_mutex_unlock(&srv->lock);
     }
-    for (int i = 0; i < c->text_count; i++)
-        free(c->text[(c->text_head + i) % SL_CLIENT_MAX_TEXT]);
-    c->text_count = 0;
+    for (int i = 0; i < c->reply_count; i++)
+        free(c->replies[(c->reply_head + i) % SL_CLIENT_MAX_TEXT].text);
+    c->reply_count = 0;
     cJSON_Delete(c->patch);
     c->patch = NULL;
     sl_frame_buf_unref(c->snapshot);
@@ -1156,27 +1209,26 @@ static int write_text_now(sl_client *c, char *text)
 
 int sl_client_write_next(sl_server *srv, sl_client *c)
 {
-    if (c->text_count > 0) {
-        int slot = c->text_head;
-        uint8_t *buf = c->text[slot];
-        size_t len = c->text_len[slot];
-        c->text[slot] = NULL;
-        c->text_head = (c->text_head + 1) % SL_CLIENT_MAX_TEXT;
-        c->text_count--;
-        int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
-        free(buf);
-        if (rc)
-            return -1;
-        if (c->text_count == 0 && c->close_after_send) {
-            lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"refused", 7);
-            return -1;
-        }
-        lws_callback_on_writable(c->wsi);
-        return 0;
-    }
-    if (c->close_after_send) {
-        lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)"refused", 7);
+    if (c->close_code && (!c->close_after_replies || c->reply_count == 0)) {
+        lws_close_reason(c->wsi, (enum lws_close_status)c->close_code, (unsigned char *)c->close_reason,
+                         strlen(c->close_reason));
         return -1;
+    }
+    if (c->reply_count > 0) {
+        sl_reply r = c->replies[c->reply_head];
+        memset(&c->replies[c->reply_head], 0, sizeof r);
+        c->reply_head = (c->reply_head + 1) % SL_CLIENT_MAX_TEXT;
+        c->reply_count--;
+        char *text = r.text;
+        if (r.code[0]) {
+            text = sl_msg_error_repeat_text(r.code, r.text, r.field, r.repeated);
+            free(r.text);
+        }
+        if (!text) {
+            sl_client_close(c, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory", 0);
+            return 0;
+        }
+        return write_text_now(c, text);
     }
     sl_session *s = c->session;
     if (!s)

@@ -43,10 +43,12 @@
  * keeps at most SL_CLIENT_MAX_TEXT replies, and a session waits for at most
  * one dataset load (so the loaders' queue is bounded by the sessions).
  * Only a client's own requests go into its reply ring (so only it can fill
- * it and get closed for it); whatever other clients or the render thread
- * cause reaches it as coalesced state on the client or session — the state
- * patch, pending control requests (one flag per requester), the session's
- * latest render error and latest frame — written when its socket is writable.
+ * it and get closed for it, with 1008 "reply budget"; its queued errors
+ * merge by code and field, so repeating a bad request never fills it);
+ * whatever other clients or the render thread cause reaches it as coalesced
+ * state on the client or session — the state patch, pending control
+ * requests (one flag per requester), the session's latest render error and
+ * latest frame — written when its socket is writable.
  */
 #ifndef SL_SERVER_H
 #define SL_SERVER_H
@@ -75,7 +77,10 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
 
 #define SL_SERVER_MAX_ORIGINS 8
 #define SL_SERVER_MAX_DATA_DIRS 8
-#define SL_CLIENT_MAX_TEXT 32          /* queued replies to the client's own requests; more closes it */
+#define SL_CLIENT_MAX_TEXT 32          /* the reply budget: queued replies to the client's own requests;
+                                          one more ends the link (1008 "reply budget") */
+#define SL_CLOSE_REASON_MAX 124        /* a close frame's reason with its NUL (RFC 6455: 123 bytes) */
+#define SL_CLOSE_GRACE_S 5             /* a link told to close that cannot take its close frame is dropped */
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
@@ -249,6 +254,17 @@ typedef struct sl_record_job {
     double t0_ms;
 } sl_record_job;
 
+/* One queued reply to a client's own request. An error is kept as its
+ * parts, so later errors of the same code and field merge into it (one
+ * message with `repeated`) while it waits: a burst of bad requests costs
+ * one slot per kind of mistake, not one per request. */
+typedef struct sl_reply {
+    char *text;                     /* owned: the whole message, or an error's sentence */
+    char code[24];                  /* an error's code; "" for any other reply */
+    char field[SL_PROTO_ID_MAX];    /* an error's field */
+    uint32_t repeated;              /* errors merged into this one after the first */
+} sl_reply;
+
 struct sl_client {                  /* [service] */
     struct lws *wsi;
     int id;
@@ -259,9 +275,8 @@ struct sl_client {                  /* [service] */
     sl_client *pending_next;        /* in server->pending (newest first) */
     char *rx;                       /* message being reassembled */
     size_t rx_len, rx_cap;
-    uint8_t *text[SL_CLIENT_MAX_TEXT]; /* ring of LWS_PRE-prefixed texts */
-    size_t text_len[SL_CLIENT_MAX_TEXT];
-    int text_head, text_count;
+    sl_reply replies[SL_CLIENT_MAX_TEXT]; /* ring: the reply budget */
+    int reply_head, reply_count;
     cJSON *patch;                   /* coalesced state patch not yet sent */
     uint32_t patch_version;
     uint32_t sent_frame_id;         /* newest frame id sent */
@@ -273,7 +288,9 @@ struct sl_client {                  /* [service] */
     uint32_t progress_seq;          /* newest session progress text sent (set at attach) */
     uint32_t record_seq;            /* session record_seq whose text was sent (set at attach) */
     uint32_t play_seq;              /* session play_seq whose text was sent (set at attach) */
-    int close_after_send;
+    int close_code;                 /* the link ends with this close code (0: open) and close_reason */
+    char close_reason[SL_CLOSE_REASON_MAX];
+    int close_after_replies;        /* the queued replies are written before the close frame */
     sl_client *next;                /* in session->clients */
 };
 
@@ -418,8 +435,19 @@ void sl_random_hex(char *out, int bytes);
 /* The session's state object (sl_msg_state_json): welcome, patches, checkpoints. Service thread. */
 cJSON *sl_session_state_json(const sl_session *s);
 /* Queues a text message for c (takes ownership of text). Returns -1 when the
- * client's queue is full (the client is then closed). */
+ * reply budget is used up (the link then ends with 1008 "reply budget"), or
+ * on a NULL text (out of memory: 1011); the text is freed either way. */
 int sl_client_queue_text(sl_client *c, char *text);
+/* Queues an `error`, merged into a queued one of the same code and field
+ * when there is one (its `repeated` counts the others; the newest message
+ * wins). Returns -1 as sl_client_queue_text. */
+int sl_client_queue_error(sl_client *c, const char *code, const char *message, const char *field);
+/* Ends c's link with a close frame: code (an RFC 6455 status) and reason
+ * (cut to SL_CLOSE_REASON_MAX - 1 bytes), at c's next writable callback,
+ * after its queued replies when after_replies is set; a peer that cannot
+ * take the frame is dropped SL_CLOSE_GRACE_S later. The first call wins;
+ * c's further messages are ignored. */
+void sl_client_close(sl_client *c, int code, const char *reason, int after_replies);
 /* Called from ws.c on writable: sends one message. Returns -1 to close. */
 int sl_client_write_next(sl_server *srv, sl_client *c);
 

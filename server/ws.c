@@ -23,7 +23,9 @@
  * --max-clients clients are past it (session.c).
  * Incoming messages are reassembled up to SL_PROTO_MAX_HELLO bytes before
  * hello and SL_PROTO_MAX_MESSAGE after; a larger one closes only that
- * connection with 1008 (policy violation). Writes happen only in
+ * connection with 1009, a binary frame with 1003, no hello within
+ * --hello-timeout with 1008 (every close says why: proto/PROTOCOL.md,
+ * "Close codes"). Writes happen only in
  * SERVER_WRITEABLE, one message per callback (session.c chooses which).
  * The render thread wakes this thread with lws_cancel_service, which arrives
  * as LWS_CALLBACK_EVENT_WAIT_CANCELLED. Never calls GL.
@@ -135,7 +137,7 @@ void sl_ws_pending_leave(sl_server *srv, sl_client *c)
 }
 
 /* The budget is full: the oldest pending connection (the list's tail) is
- * closed at the next service pass and ignored until then. */
+ * closed with 1008 at its next writable callback and ignored until then. */
 static void evict_oldest_pending(sl_server *srv)
 {
     sl_client *oldest = srv->pending;
@@ -145,8 +147,10 @@ static void evict_oldest_pending(sl_server *srv)
         return;
     lwsl_notice("evicted a pending WebSocket from %s (--max-pending %d)\n", oldest->addr, srv->cfg.max_pending);
     sl_ws_pending_leave(srv, oldest);
-    oldest->close_after_send = 1;
-    lws_set_timeout(oldest->wsi, PENDING_TIMEOUT_USER_REASON_BASE + 2, LWS_TO_KILL_ASYNC);
+    char reason[80];
+    snprintf(reason, sizeof reason, "pending budget: %d connections without hello (--max-pending)",
+             srv->cfg.max_pending);
+    sl_client_close(oldest, LWS_CLOSE_STATUS_POLICY_VIOLATION, reason, 0);
     pthread_mutex_lock(&srv->lock);
     srv->metrics.pending_evicted++;
     pthread_mutex_unlock(&srv->lock);
@@ -174,6 +178,13 @@ static int admission_refused(sl_server *srv, const char *addr)
     return 1;
 }
 
+/* Ends wsi's link from its own callback with a close frame; returns -1, which the callback returns. */
+static int close_now(struct lws *wsi, enum lws_close_status code, const char *reason)
+{
+    lws_close_reason(wsi, code, (unsigned char *)reason, strlen(reason));
+    return -1;
+}
+
 static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
     ws_pss *pss = user;
@@ -192,7 +203,7 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
     case LWS_CALLBACK_ESTABLISHED: {
         sl_client *c = calloc(1, sizeof *c);
         if (!c)
-            return -1;
+            return close_now(wsi, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory");
         sl_ws_client_address(srv, wsi, 0, c->addr, sizeof c->addr);
         /* Checked again: another upgrade may have been established since the filter. */
         if (admission_refused(srv, c->addr)) {
@@ -207,8 +218,10 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
         c->pending_next = srv->pending;
         srv->pending = c;
         pss->client = c;
-        /* hello must come within --hello-timeout s (cleared in session.c when it does). */
-        lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, srv->cfg.hello_timeout_s);
+        /* hello must come within --hello-timeout s (LWS_CALLBACK_TIMER closes with 1008; both are
+         * cleared in session.c when it comes; the timeout drops a link that cannot take the close). */
+        lws_set_timer_usecs(wsi, (lws_usec_t)srv->cfg.hello_timeout_s * LWS_USEC_PER_SEC);
+        lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, srv->cfg.hello_timeout_s + SL_CLOSE_GRACE_S);
         pthread_mutex_lock(&srv->lock);
         srv->pending_count++;
         pthread_mutex_unlock(&srv->lock);
@@ -229,25 +242,34 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
             }
         }
         return 0;
+    case LWS_CALLBACK_TIMER: {
+        sl_client *c = pss->client;
+        if (!c || c->hello_done || c->close_code)
+            return 0;
+        char reason[64];
+        snprintf(reason, sizeof reason, "no hello within %d s (--hello-timeout)", srv->cfg.hello_timeout_s);
+        return close_now(wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, reason);
+    }
     case LWS_CALLBACK_RECEIVE: {
         sl_client *c = pss->client;
         if (!c)
             return -1;
-        if (c->close_after_send)
-            return 0; /* refused: only the pending error is still sent */
+        if (c->close_code)
+            return 0; /* closing: only what was queued before is still sent */
+        if (lws_frame_is_binary(wsi))
+            return close_now(wsi, LWS_CLOSE_STATUS_UNACCEPTABLE_OPCODE, "binary frames are not part of the protocol");
         size_t limit = c->hello_done ? SL_PROTO_MAX_MESSAGE : SL_PROTO_MAX_HELLO;
         size_t remaining = lws_remaining_packet_payload(wsi);
         if (c->rx_len + len + remaining > limit) {
-            char reason_text[64];
-            int n = snprintf(reason_text, sizeof reason_text, "message over %zu bytes", limit);
-            lws_close_reason(wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION, (unsigned char *)reason_text, (size_t)n);
-            return -1;
+            char reason[64];
+            snprintf(reason, sizeof reason, "message over %zu bytes", limit);
+            return close_now(wsi, LWS_CLOSE_STATUS_MESSAGE_TOO_LARGE, reason);
         }
         if (c->rx_len + len + 1 > c->rx_cap) {
             size_t cap = c->rx_len + len + remaining + 1;
             char *p = realloc(c->rx, cap);
             if (!p)
-                return -1;
+                return close_now(wsi, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory");
             c->rx = p;
             c->rx_cap = cap;
         }
@@ -256,10 +278,6 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
         if (lws_is_final_fragment(wsi) && lws_remaining_packet_payload(wsi) == 0) {
             size_t n = c->rx_len;
             c->rx_len = 0;
-            if (lws_frame_is_binary(wsi)) {
-                sl_client_queue_text(c, sl_msg_error_text("bad_json", "binary messages are not accepted; send JSON text", ""));
-                return 0;
-            }
             sl_sessions_on_text(srv, c, c->rx, n);
         }
         return 0;

@@ -7,7 +7,7 @@
  * gives half-size interactive frames then a full-size still; malformed JSON, unknown type,
  * unknown and out-of-range parameters each give an `error` and the
  * connection keeps working; oversize messages close only that connection
- * (1008); a wrong token is refused; two clients of one session see each
+ * (1009); a wrong token is refused; two clients of one session see each
  * other's changes and the same frame ids; viewers are refused until granted
  * control; the ack window holds; snapshots are PNGs; views save and load;
  * scene switches (a vanished file gives load_failed without the server's
@@ -45,13 +45,7 @@ static int error_is(cJSON *j, const char *code, const char *field)
 /* The connection still answers: ping -> pong with the same seq. */
 static int still_usable(tclient *c, int seq)
 {
-    if (tclient_send(c, "{\"type\":\"ping\",\"seq\":%d}", seq))
-        return 0;
-    cJSON *p = tclient_wait_type(c, "pong", T);
-    const cJSON *s = cJSON_GetObjectItemCaseSensitive(p, "seq");
-    int ok = p && cJSON_IsNumber(s) && s->valueint == seq;
-    cJSON_Delete(p);
-    return ok;
+    return tclient_ping(c, seq, T);
 }
 
 static int http_get(int port, const char *path, char *out, size_t out_size)
@@ -379,7 +373,7 @@ int main(void)
     cJSON *junk = NULL;
     int r = tclient_next(&big, T, &junk);
     cJSON_Delete(junk);
-    SL_CHECK_MSG(r == 0 && big.close_code == 1008, "before hello: r=%d close=%d", r, big.close_code);
+    SL_CHECK_MSG(r == 0 && big.close_code == 1009, "before hello: r=%d close=%d", r, big.close_code);
     tclient_close(&big);
     SL_CHECK(tclient_connect(&big, h.port, NULL) == 0);
     SL_CHECK(tclient_hello(&big, NULL, NULL, 32, 32) == 0);
@@ -395,7 +389,7 @@ int main(void)
         r = tclient_next(&big, T, &junk);
         cJSON_Delete(junk);
     } while (r > 0);
-    SL_CHECK_MSG(r == 0 && big.close_code == 1008, "after hello: r=%d close=%d", r, big.close_code);
+    SL_CHECK_MSG(r == 0 && big.close_code == 1009, "after hello: r=%d close=%d", r, big.close_code);
     tclient_close(&big);
     SL_CHECK(still_usable(&a, 3));
 

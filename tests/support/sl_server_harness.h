@@ -11,7 +11,8 @@
  * the catalog file of a running harness; harness_signal and harness_wait
  * let a test kill a node or watch it drain. tclient wraps sl_wsclient: it
  * parses text messages into cJSON, records every binary frame (header +
- * payload copy) and acks frames when auto_ack is set. harness_cli_render
+ * payload copy), keeps the close frame's code and reason (tclient_wait_close)
+ * and acks frames when auto_ack is set. harness_cli_render
  * renders a reference with sightline-render. tclient_connect_page connects
  * as the page does (/ws?session=ID, which a balancer routes by); a cluster
  * of nodes behind HAProxy is sl_cluster.h. Loopback only.
@@ -334,6 +335,7 @@ typedef struct tclient {
     sl_wsclient *ws;
     int auto_ack;
     int closed, close_code;
+    char close_reason[124];        /* the server's close frame's reason ("" none) */
     int frames;                    /* binary frames received */
     tframe last;                   /* newest frame */
     uint32_t frame_ids[256];       /* ids of the first 256 frames */
@@ -406,6 +408,7 @@ static __attribute__((unused)) int tclient_next(tclient *c, int timeout_ms, cJSO
     if (kind == SL_WS_CLOSED) {
         c->closed = 1;
         c->close_code = code;
+        snprintf(c->close_reason, sizeof c->close_reason, "%.*s", (int)size, (const char *)data);
         return 0;
     }
     if (kind == SL_WS_TEXT) {
@@ -457,6 +460,35 @@ static __attribute__((unused)) cJSON *tclient_wait_type(tclient *c, const char *
             return NULL;
     }
     return NULL;
+}
+
+/* Sends ping `seq` and waits for its pong (other messages are consumed):
+ * 1 when it came, 0 when not within timeout_ms or the link closed. */
+static __attribute__((unused)) int tclient_ping(tclient *c, int seq, int timeout_ms)
+{
+    if (tclient_send(c, "{\"type\":\"ping\",\"seq\":%d}", seq))
+        return 0;
+    cJSON *p = tclient_wait_type(c, "pong", timeout_ms);
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(p, "seq");
+    int ok = p && cJSON_IsNumber(s) && s->valueint == seq;
+    cJSON_Delete(p);
+    return ok;
+}
+
+/* Reads (and drops) messages until the server's close frame: 0 with
+ * c->close_code and c->close_reason set, or -1 when the connection drops
+ * without one (1006) or nothing closes it within timeout_ms. */
+static __attribute__((unused)) int tclient_wait_close(tclient *c, int timeout_ms)
+{
+    double deadline = sl_clock_ms() + timeout_ms;
+    while (!c->closed && sl_clock_ms() < deadline) {
+        cJSON *j = NULL;
+        int r = tclient_next(c, (int)(deadline - sl_clock_ms()) + 1, &j);
+        cJSON_Delete(j);
+        if (r == 0)
+            return 0;
+    }
+    return c->closed && c->close_code ? 0 : -1;
 }
 
 /* Waits for a JPEG frame whose camera_seq >= seq and (still_only) not interactive. Returns 0 on success. */

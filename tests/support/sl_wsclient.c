@@ -344,10 +344,22 @@ sl_status sl_wsclient_recv(sl_wsclient *c, int timeout_ms, sl_ws_kind *kind, con
                 continue;
             }
             if (opcode == 8) {
+                /* The reason (after the 2-byte code) goes where a message would. */
+                size_t reason = len >= 2 ? (size_t)len - 2 : 0;
+                if (c->msg_cap < reason + 1) {
+                    uint8_t *m = realloc(c->msg, reason + 1);
+                    if (!m)
+                        return sl_err_set(err, SL_ERR_NOMEM, "cannot allocate a close reason");
+                    c->msg = m;
+                    c->msg_cap = reason + 1;
+                }
+                memcpy(c->msg, ctl + 2, reason);
+                c->msg[reason] = 0;
+                c->msg_size = reason;
                 *kind = SL_WS_CLOSED;
                 *close_code = len >= 2 ? (ctl[0] << 8 | ctl[1]) : 1005;
-                *data = NULL;
-                *size = 0;
+                *data = c->msg;
+                *size = reason;
                 return SL_OK;
             }
             continue; /* pong */

@@ -48,7 +48,9 @@ sl_status sl_wsclient_send_texts(sl_wsclient *c, const char *const *texts, int c
 /* Receives one whole message that starts within timeout_ms (once started, it
  * has 10 s to complete, so a timeout never splits a message). *data is owned by the
  * client and valid until the next receive; it is NUL-terminated for text.
- * On a close frame returns SL_OK with *kind = SL_WS_CLOSED and *close_code.
+ * On a close frame returns SL_OK with *kind = SL_WS_CLOSED, *close_code
+ * (1005 when the frame has none) and the close reason in *data / *size
+ * (NUL-terminated, "" when there is none).
  * Returns SL_ERR_IO on timeout (message says "timeout") or a dropped
  * connection, SL_ERR_LIMIT above max_bytes. */
 sl_status sl_wsclient_recv(sl_wsclient *c, int timeout_ms, sl_ws_kind *kind, const uint8_t **data,

@@ -141,6 +141,15 @@ int main(void)
     cJSON *ej = cJSON_Parse(e);
     SL_CHECK(ej && strcmp(cJSON_GetObjectItem(ej, "type")->valuestring, "error") == 0);
     SL_CHECK(ej && strcmp(cJSON_GetObjectItem(ej, "field")->valuestring, "params.x") == 0);
+    SL_CHECK(ej && !cJSON_GetObjectItem(ej, "repeated"));
+    cJSON_Delete(ej);
+    free(e);
+    /* merged errors: `repeated` counts the ones after the first */
+    e = sl_msg_error_repeat_text("bad_param", "x must be in [0, 1]", "params.x", 49);
+    ej = cJSON_Parse(e);
+    const cJSON *rep = cJSON_GetObjectItem(ej, "repeated");
+    SL_CHECK(ej && cJSON_IsNumber(rep) && rep->valueint == 49);
+    SL_CHECK(ej && strcmp(cJSON_GetObjectItem(ej, "code")->valuestring, "bad_param") == 0);
     cJSON_Delete(ej);
     free(e);
 
