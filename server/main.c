@@ -7,6 +7,7 @@
  *                    [--default-dataset NAME] [--hello-timeout S] [--node-id NAME] [--agent-port P]
  *                    [--trusted-proxy ADDR[/BITS]]...
  *                    [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-frame-time-ms MS]
+ *                    [--test-frame-time-fixed-ms MS]
  *                    [--test-load-delay-ms MS]   (the --test-* options are for tests only)
  *   sightline-server [--db PATH|URL] [--data-dir DIR] catalog add PATH | add-generator NAME JSON | list
  *                    | remove NAME | refresh NAME | scan DIR | add-builtins
@@ -79,7 +80,8 @@ static void usage(FILE *f)
             "                        [--max-pending-per-address N] [--max-sessions N] [--grace SECONDS]\n"
             "                        [--idle-release SECONDS] [--egl-device software|INDEX] [--default-dataset NAME]\n"
             "                        [--hello-timeout S] [--node-id NAME] [--agent-port P] [--trusted-proxy ADDR[/BITS]]...\n"
-            "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-frame-time-ms MS] [--test-load-delay-ms MS]\n"
+            "                        [--test-frame-delay-ms MS] [--test-frame-fixed-ms MS] [--test-frame-time-ms MS]\n"
+            "                        [--test-frame-time-fixed-ms MS] [--test-load-delay-ms MS]\n"
             "                        (tests only: sleep MS x frame pixels / session pixels, and MS, in every\n"
             "                        frame's render, and MS before every dataset load, so a scene is slow in a\n"
             "                        known way)\n"
@@ -277,6 +279,10 @@ int main(int argc, char **argv)
             int ms = 0;
             ok = parse_int(v, 0, 10000, &ms), i++;
             cfg.test_frame_time_ms = ms;
+        } else if (strcmp(a, "--test-frame-time-fixed-ms") == 0 && v) {
+            int ms = 0;
+            ok = parse_int(v, 0, 10000, &ms), i++;
+            cfg.test_frame_time_fixed_ms = ms;
         } else if (strcmp(a, "--test-load-delay-ms") == 0 && v) {
             int ms = 0;
             ok = parse_int(v, 0, 60000, &ms), i++;

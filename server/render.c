@@ -499,8 +499,10 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
         return;
     }
     double seen_ms = render_ms + encode_ms;
-    if (ctx->srv->cfg.test_frame_time_ms > 0) /* tests: an injected cost, whatever this machine's speed */
-        seen_ms = ctx->srv->cfg.test_frame_time_ms * ((double)w * h) / ((double)st->width * st->height);
+    if (ctx->srv->cfg.test_frame_time_ms > 0 || ctx->srv->cfg.test_frame_time_fixed_ms > 0)
+        /* tests: an injected cost, whatever this machine's speed */
+        seen_ms = ctx->srv->cfg.test_frame_time_ms * ((double)w * h) / ((double)st->width * st->height) +
+                  ctx->srv->cfg.test_frame_time_fixed_ms;
     sl_iscale_record(&s->iscale, interactive, step, seen_ms);
     s->good = *st;
     s->has_good = 1;

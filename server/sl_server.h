@@ -113,6 +113,7 @@ typedef struct sl_server_config {
     double test_frame_fixed_ms;    /* tests only: and this, whatever the size (a vertex-bound render) */
     double test_frame_time_ms;     /* tests only, > 0: the adaptive scale sees this x (frame pixels / session
                                       pixels) as a frame's time instead of the measured one (no sleep) */
+    double test_frame_time_fixed_ms; /* tests only, > 0: and this more, whatever the size (injected as above) */
     double test_load_delay_ms;     /* tests only: every dataset load sleeps this long first (loader thread) */
 } sl_server_config;
 

@@ -34,7 +34,7 @@ docker_count="$(printf '%s\n' "$docker_list" | grep -c .)"
 check '[ "$docker_count" -ge 10 ]' "Dockerfile package list has the packages ($docker_count)"
 list_diff="$(diff <(echo "$docker_list") <(echo "$deps_list") | tr '\n' ' ')"
 check '[ "$docker_list" = "$deps_list" ]' "Dockerfile and scripts/install-deps install the same packages: $list_diff"
-check 'printf "%s\n" "$docker_list" | grep -qx libwebsockets-dev' "libwebsockets-dev is in the list"
+check 'grep -qx libwebsockets-dev <<<"$docker_list"' "libwebsockets-dev is in the list"
 check 'grep -q "scripts/install-deps" "$root/scripts/run"' "scripts/run installs through scripts/install-deps"
 
 # 3. No package names besides the list: strip the substitution and flags from every apt-get install.
@@ -51,7 +51,7 @@ check '[ -z "$extra" ]' "Dockerfile installs packages outside packages.txt:$extr
 # 4. Shape of the image.
 check 'grep -Eq "^FROM debian:(12|bookworm)" "$df"' "Debian 12 base"
 check 'grep -Eq "^EXPOSE 8080" "$df"' "EXPOSE 8080"
-check 'printf "%s\n" "$joined" | grep -Eq "^HEALTHCHECK .*/healthz"' "HEALTHCHECK on /healthz"
+check 'grep -Eq "^HEALTHCHECK .*/healthz" <<<"$joined"' "HEALTHCHECK on /healthz"
 check 'grep -Eq "^USER [a-z]" "$df" && ! grep -Eq "^USER root" "$df"' "runs as a non-root user"
 check 'grep -q "sightline-server" "$df"' "builds and runs sightline-server"
 # The build context leaves out build folders, npm modules and downloaded samples.
