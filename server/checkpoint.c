@@ -42,6 +42,11 @@ sl_status sl_checkpoint_token_hash(const char *token, char hex[65], sl_err *err)
     return SL_OK;
 }
 
+void sl_checkpoint_crypto_cleanup(void)
+{
+    OPENSSL_cleanup();
+}
+
 int sl_checkpoint_token_matches(const char *token, const char *want_hex)
 {
     char hex[65];

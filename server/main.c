@@ -403,5 +403,6 @@ done:
     pthread_cond_destroy(&srv->wake);
     pthread_mutex_destroy(&srv->lock);
     free(srv);
+    sl_checkpoint_crypto_cleanup();
     return rc;
 }

@@ -560,6 +560,10 @@ void sl_render_stop(sl_server *srv);
 /* checkpoint.c (service thread) */
 /* Lowercase hex SHA-256 of token into hex (65 bytes). SL_ERR_NOMEM when libcrypto fails. */
 sl_status sl_checkpoint_token_hash(const char *token, char hex[65], sl_err *err);
+/* Frees libcrypto's state (its per-thread error queue included) at the end of
+ * main, once no thread uses it: the exit-time leak check (sl_leak_check.h) can
+ * run before libcrypto's own atexit cleanup and would report it. */
+void sl_checkpoint_crypto_cleanup(void);
 /* 1 when SHA-256(token) equals want_hex, compared in constant time. */
 int sl_checkpoint_token_matches(const char *token, const char *want_hex);
 /* Writes the session's checkpoint (its state, this node as owner, the
