@@ -129,6 +129,9 @@ export class ParamControls {
       context.histogram || null, context.autoOpacity || null]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
+    // A rebuild (the catalog told more of the dataset, say) keeps what the
+    // user selected in an editor: a colour picked next applies to that point.
+    const selections = new Map([...this.inputs].filter(([, e]) => e.editor).map(([n, e]) => [n, e.editor.selected]));
     this.form.replaceChildren();
     this.inputs.clear();
     this.inkName = null;
@@ -281,12 +284,14 @@ export class ParamControls {
         entry = { def, set: (v) => { if (Array.isArray(v)) pick.value = rgbToHex(v); } };
       } else if (def.type === 'transfer_function') {
         const ed = new TransferFunctionEditor(row, def, (v) => this.onChange(def.name, v), this.context);
+        if (selections.has(def.name)) ed.selected = selections.get(def.name);
         row.classList.add('tf');
         entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'transfer_2d') {
         const ink = schema.find((d) => d.type === 'vec3' && d.unit === 'rgb');
         this.inkName = ink ? ink.name : null;
         const ed = new Tf2dEditor(row, def, (v) => this.onChange(def.name, v), ink ? ink.default : undefined);
+        if (selections.has(def.name)) ed.selected = selections.get(def.name);
         row.classList.add('tf');
         entry = { def, set: (v) => ed.set(v), editor: ed };
       } else if (def.type === 'vec3') {

@@ -117,9 +117,10 @@ export class Tf2dEditor {
     this.set(def.default);
   }
 
-  // Shows a value from the session (welcome or state patch); ignored while dragging.
+  // Shows a value from the session (welcome or state patch); ignored while dragging
+  // and while an edit waits to be sent (throttle.js).
   set(v) {
-    if (this.dragging || !v || !Array.isArray(v.widgets)) return;
+    if (this.dragging || this.send.pending() || !v || !Array.isArray(v.widgets)) return;
     this.range = v.range > 0 ? v.range : this.range;
     this.widgets = v.widgets.map((w) => w.slice(0, 7));
     if (this.selected >= this.widgets.length) this.selected = -1;

@@ -115,9 +115,10 @@ export class TransferFunctionEditor {
     return p[p.length - 1].rgb || [0.5, 0.5, 0.5];
   }
 
-  // Shows a value from the session (welcome or state patch); ignored while dragging.
+  // Shows a value from the session (welcome or state patch); ignored while dragging
+  // and while an edit waits to be sent (throttle.js).
   set(v) {
-    if (this.dragging) return;
+    if (this.dragging || this.send.pending()) return;
     this.auto = !!(v && v.opacity === 'auto');
     if (Array.isArray(v)) {
       this.colormap = null;
@@ -133,6 +134,7 @@ export class TransferFunctionEditor {
     }
     this.preset.value = this.colormap || '';
     if (this.selected >= this.points.length) this.selected = -1;
+    if (this.selected >= 0 && !this.canvas.disabled) this.syncColour();
     this.draw();
   }
 

@@ -5,13 +5,18 @@
 
 // Returns send(final): calls fn() now when `ms` have passed since the last
 // call or when `final` (the end of a drag), else once when they have.
+// send.pending() is true while a call waits for its turn: an editor shows no
+// value from the server then, or the echo of an older edit would replace the
+// newer one before it is sent.
 export function throttle(fn, ms) {
   let last = 0, timer = null;
-  return (final = false) => {
+  const send = (final = false) => {
     clearTimeout(timer);
     timer = null;
     const wait = last + ms - performance.now();
     if (final || wait <= 0) { last = performance.now(); fn(); return; }
     timer = setTimeout(() => { timer = null; last = performance.now(); fn(); }, wait);
   };
+  send.pending = () => timer !== null;
+  return send;
 }

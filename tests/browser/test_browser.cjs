@@ -479,6 +479,7 @@ async function volumeScene(page, obs, sess, banner) {
   const range = await page.evaluate(() => window.sightline.datasets.find((d) =>
     d.name === window.sightline.state.dataset).counts.value_range);
   box = await cv.boundingBox();
+  const canvasBefore = await cv.elementHandle();
   await page.mouse.click(...at(1, 0.6));
   await page.locator(`#params input[type=color][name="${tfDef.name}.color"]`).fill('#ff0000');
   const coloured = await serverStateWhere(obs, sess, (s) => {
@@ -487,6 +488,14 @@ async function volumeScene(page, obs, sess, banner) {
     return p && Math.abs(p[0] - range[1]) <= 0.01 * (range[1] - range[0]) && p[1] === 1 && p[2] === 0 &&
       p[3] === 0 && Math.abs(p[4] - 0.6) < 0.03;
   }, 'tf colour');
+  if (!coloured) {
+    console.error('tf colour: the page sent', JSON.stringify(await page.evaluate((n) => window.sightline.sent
+      .filter((m) => m.type === 'set' && m.params && n in m.params).slice(-4), tfDef.name)),
+    'banner', JSON.stringify(await page.textContent('#banner')),
+    'editor rebuilt', await canvasBefore.evaluate((c) => !c.isConnected),
+    'colour input', JSON.stringify(await page.$eval(`#params input[type=color][name="${tfDef.name}.color"]`,
+      (e) => ({ value: e.value, disabled: e.disabled }))));
+  }
   check(coloured, `point ${last} coloured #ff0000 at value ${range[1]} on the server`);
   await settled(page);
 
@@ -667,6 +676,36 @@ async function syntheticHeldParams(page) {
   check(r.echo && r.later, 'the echo of the value sent is shown and releases the hold');
   check(r.released === 0, 'release() drops every hold');
   check(same(r.eq, [true, false, false, false]), `sameJson: numbers within 1e-6, shapes exact (${r.eq})`);
+
+  // An edit waiting in the throttle is not replaced by a value from the
+  // server (the echo of the previous edit): the colour picked right after a
+  // click reaches the server.
+  const p = await page.evaluate(async () => {
+    const { throttle } = await import('/throttle.js');
+    const { TransferFunctionEditor } = await import('/tf_editor.js');
+    let calls = 0;
+    const t = throttle(() => calls++, 50);
+    t(true);
+    t();
+    const waiting = t.pending(), callsThen = calls;
+    await new Promise((res) => setTimeout(res, 120));
+    const sent = [];
+    const row = document.createElement('div');
+    const ed = new TransferFunctionEditor(row, { name: 'zz_tf', default: { colormap: 'viridis', opacity: [[0, 0], [1, 1]] },
+      colormaps: [{ name: 'viridis', colors: [[0, 0, 0.3], [1, 1, 0]] }] }, (v) => sent.push(v), { valueRange: [0, 10] });
+    ed.set({ colormap: 'viridis', opacity: [[0, 0], [1, 1]] });
+    ed.send(true);
+    ed.selected = 1;
+    ed.recolour([1, 0, 0]);   // waits for its turn
+    const pendingEdit = ed.send.pending();
+    ed.set({ colormap: 'viridis', opacity: [[0, 0], [1, 1]] });   // the echo of the edit before
+    await new Promise((res) => setTimeout(res, 200));
+    return { waiting, callsThen, callsAfter: calls, pending: t.pending(), pendingEdit, last: sent[sent.length - 1] };
+  });
+  check(p.waiting && p.callsThen === 1 && p.callsAfter === 2 && !p.pending,
+    `throttle: a call waits for its turn (pending), then runs (${JSON.stringify(p)})`);
+  check(p.pendingEdit && Array.isArray(p.last) && p.last[1][1] === 1 && p.last[1][2] === 0 && p.last[1][3] === 0,
+    `an echo arriving while a colour edit waits does not replace it: sent ${JSON.stringify(p.last)}`);
 }
 
 // The two attribute rules of controls.js on a synthetic schema, so they
