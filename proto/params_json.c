@@ -236,8 +236,11 @@ static sl_status apply_one(sl_params *p, const cJSON *item, sl_err *err)
         return apply_transfer_2d(p, name, item, err);
     case SL_PARAM_FLOAT:
     case SL_PARAM_INT:
+        if (sl_param_def_has_auto(d) && cJSON_IsString(item) && strcmp(item->valuestring, "auto") == 0)
+            return sl_params_set_auto(p, name, err);
         if (!cJSON_IsNumber(item))
-            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a number in [%g, %g]", name, d->min, d->max);
+            return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' must be a number in [%g, %g]%s", name, d->min,
+                              d->max, sl_param_def_has_auto(d) ? " or \"auto\"" : "");
         return sl_params_set_numbers(p, name, &item->valuedouble, 1, err);
     }
     return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' has an unknown type", name);
@@ -319,6 +322,9 @@ static cJSON *value_json(const sl_param_def *d, const double *v)
     case SL_PARAM_ENUM: return cJSON_CreateString(d->choices[(int)v[0]]);
     case SL_PARAM_VEC3: return cJSON_CreateDoubleArray(v, 3);
     case SL_PARAM_FLOAT:
+        if (isnan(v[0])) /* auto (sl_param_def_has_auto); no other float holds NaN */
+            return cJSON_CreateString("auto");
+        return cJSON_CreateNumber(v[0]);
     case SL_PARAM_INT:
     case SL_PARAM_ATTRIBUTE: return cJSON_CreateNumber(v[0]);
     }

@@ -306,6 +306,29 @@ static int checked_index(const sl_params *p, const char *name, sl_param_type typ
     return i;
 }
 
+int sl_param_def_has_auto(const sl_param_def *d)
+{
+    return d->type == SL_PARAM_FLOAT && isnan(d->def[0]);
+}
+
+sl_status sl_params_set_auto(sl_params *p, const char *name, sl_err *err)
+{
+    int i = sl_params_find(p, name);
+    if (i < 0)
+        return unknown_parameter(p, name, err);
+    if (!sl_param_def_has_auto(&p->schema[i]))
+        return sl_err_set(err, SL_ERR_INVALID, "parameter '%s' has no \"auto\" value: give a number in [%g, %g]%s%s",
+                          name, p->schema[i].min, p->schema[i].max, p->schema[i].unit[0] ? " " : "", p->schema[i].unit);
+    memcpy(p->value[i], p->schema[i].def, sizeof p->schema[i].def);
+    return SL_OK;
+}
+
+int sl_params_is_auto(const sl_params *p, const char *name)
+{
+    int i = checked_index(p, name, SL_PARAM_FLOAT);
+    return i >= 0 && isnan(p->value[i][0]);
+}
+
 double sl_params_float(const sl_params *p, const char *name)
 {
     int i = checked_index(p, name, SL_PARAM_FLOAT);

@@ -10,14 +10,19 @@
 #ifndef SL_PARAMS_H
 #define SL_PARAMS_H
 
+#include <math.h> /* NAN, for SL_PARAM_AUTO */
 #include <stdbool.h>
 
 #include "sl_status.h"
 
 #define SL_PARAMS_MAX 48
+#define SL_PARAM_AUTO NAN /* sl_param_def.def[0] of a FLOAT whose default is "auto" */
 
 typedef enum sl_param_type {
-    SL_PARAM_FLOAT, /* one double in [min, max] */
+    SL_PARAM_FLOAT, /* one double in [min, max]; with def[0] = SL_PARAM_AUTO the
+                       default is "auto": the technique picks the value per
+                       dataset (sl_params_float gives NaN, sl_params_is_auto 1);
+                       a number sets it, sl_params_set_auto sets auto again */
     SL_PARAM_INT,   /* one integer in [min, max] */
     SL_PARAM_BOOL,  /* 0 or 1 */
     SL_PARAM_ENUM,  /* index into choices (given and reported by name) */
@@ -142,6 +147,12 @@ int sl_params_find(const sl_params *p, const char *name);
  * index: "parameter 'isovalues': value 2 = 7 is out of range [0, 1] data"). */
 sl_status sl_params_set_numbers(sl_params *p, const char *name, const double *v, int n, sl_err *err);
 sl_status sl_params_set_choice(sl_params *p, const char *name, const char *choice, sl_err *err);
+/* Back to "auto": only a FLOAT whose schema default is SL_PARAM_AUTO takes it. */
+sl_status sl_params_set_auto(sl_params *p, const char *name, sl_err *err);
+/* 1 when d is a FLOAT whose default is auto (def[0] is SL_PARAM_AUTO). */
+int sl_param_def_has_auto(const sl_param_def *d);
+/* 1 when the FLOAT `name` is auto (then sl_params_float is NaN). */
+int sl_params_is_auto(const sl_params *p, const char *name);
 
 /* Checked setter of a SL_PARAM_TRANSFER parameter: on failure nothing
  * changes and err names the parameter and the bad point ("point 3 ...")

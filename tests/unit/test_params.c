@@ -149,6 +149,10 @@ static cJSON *other_value(const sl_param_def *d, double out[3])
     case SL_PARAM_VEC3:
         if (d->min == d->max)
             return NULL;
+        if (isnan(d->def[0])) { /* auto: a number in the range is the other value */
+            out[0] = 0.5 * d->min + 0.5 * d->max;
+            return cJSON_CreateNumber(out[0]);
+        }
         out[0] = d->def[0] < d->max ? d->def[0] + 0.5 * (d->max - d->def[0]) : 0.5 * (d->min + d->def[0]);
         return d->type == SL_PARAM_FLOAT ? cJSON_CreateNumber(out[0]) : cJSON_CreateDoubleArray(out, 3);
     case SL_PARAM_INT:
@@ -204,6 +208,11 @@ static void check_schema_json(const cJSON *o, const sl_param_def *d, const char 
     int def_ok = 0;
     switch (d->type) {
     case SL_PARAM_FLOAT:
+        if (isnan(d->def[0])) { /* an "auto" default (SL_PARAM_AUTO) */
+            def_ok = cJSON_IsString(def) && strcmp(def->valuestring, "auto") == 0;
+            break;
+        }
+        /* fall through */
     case SL_PARAM_INT:
     case SL_PARAM_ATTRIBUTE: def_ok = cJSON_IsNumber(def) && def->valuedouble == d->def[0]; break;
     case SL_PARAM_BOOL: def_ok = cJSON_IsBool(def) && cJSON_IsTrue(def) == (d->def[0] != 0.0); break;
@@ -675,7 +684,8 @@ static void test_parameter(const sl_technique *t, int i)
         /* fall through */
     case SL_PARAM_FLOAT:
         in_range &= isfinite(d->min) && isfinite(d->max) && d->min <= d->max;
-        in_range &= d->def[0] >= d->min && d->def[0] <= d->max;
+        in_range &= (d->type == SL_PARAM_FLOAT && sl_param_def_has_auto(d)) ||
+                    (d->def[0] >= d->min && d->def[0] <= d->max);
         break;
     case SL_PARAM_BOOL:
         in_range &= d->def[0] == 0.0 || d->def[0] == 1.0;
@@ -691,8 +701,12 @@ static void test_parameter(const sl_technique *t, int i)
     }
     SL_CHECK_MSG(in_range, "%s.%s: default out of its own range", t->name, d->name);
     sl_params p = base;
-    SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, d->def, d->type == SL_PARAM_VEC3 ? 3 : 1, &err) == SL_OK,
-                 "%s.%s: the default does not validate: %s", t->name, d->name, err.message);
+    if (sl_param_def_has_auto(d)) /* auto is set by name, never as a number (NaN is refused) */
+        SL_CHECK_MSG(sl_params_set_auto(&p, d->name, &err) == SL_OK && sl_params_is_auto(&p, d->name),
+                     "%s.%s: the auto default does not validate: %s", t->name, d->name, err.message);
+    else
+        SL_CHECK_MSG(sl_params_set_numbers(&p, d->name, d->def, d->type == SL_PARAM_VEC3 ? 3 : 1, &err) == SL_OK,
+                     "%s.%s: the default does not validate: %s", t->name, d->name, err.message);
 
     /* A valid other value: applied, reported at the declared level. */
     double want[3];
@@ -1161,8 +1175,52 @@ static void test_numeric_enum(void)
     cJSON_Delete(patch);
 }
 
+/* A FLOAT whose default is "auto" (SL_PARAM_AUTO): NaN inside, "auto" in
+ * JSON both ways; a number sets it, "auto" sets it back, NaN as a number and
+ * "auto" on a float without an auto default are refused; equal autos
+ * compare equal (bytewise), a number against auto differs. */
+static void test_auto_float(void)
+{
+    static const sl_param_def schema[] = {
+        {"level", SL_PARAM_FLOAT, -10.0, 10.0, {SL_PARAM_AUTO}, NULL, "data", "a level", SL_INVALIDATE_FRAME},
+        {"plain", SL_PARAM_FLOAT, 0.0, 1.0, {0.5}, NULL, "", "a plain float", SL_INVALIDATE_FRAME},
+    };
+    sl_params p, base;
+    sl_params_init(&p, schema, 2);
+    base = p;
+    sl_err err = {0};
+    SL_CHECK(sl_param_def_has_auto(&schema[0]) && !sl_param_def_has_auto(&schema[1]));
+    SL_CHECK(sl_params_is_auto(&p, "level") && isnan(sl_params_float(&p, "level")) && !sl_params_is_auto(&p, "plain"));
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_NONE);
+    cJSON *all = sl_params_to_json(&p);
+    const cJSON *lv = cJSON_GetObjectItemCaseSensitive(all, "level");
+    SL_CHECK_MSG(cJSON_IsString(lv) && strcmp(lv->valuestring, "auto") == 0, "auto is reported as \"auto\"");
+    cJSON_Delete(all);
+    cJSON *patch = cJSON_Parse("{\"level\": 2.5}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && sl_params_float(&p, "level") == 2.5 &&
+             !sl_params_is_auto(&p, "level"));
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_FRAME);
+    patch = cJSON_Parse("{\"level\": \"auto\"}");
+    SL_CHECK(sl_params_apply_json(&p, patch, &err) == SL_OK && sl_params_is_auto(&p, "level"));
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_compare(&base, &p) == SL_INVALIDATE_NONE);
+    double nan = NAN;
+    sl_params q = p;
+    SL_CHECK(sl_params_set_numbers(&q, "level", &nan, 1, &err) == SL_ERR_INVALID && strstr(err.message, "finite"));
+    patch = cJSON_Parse("{\"plain\": \"auto\"}");
+    SL_CHECK(sl_params_apply_json(&q, patch, &err) == SL_ERR_INVALID && strstr(err.message, "plain"));
+    cJSON_Delete(patch);
+    SL_CHECK(sl_params_set_auto(&q, "plain", &err) == SL_ERR_INVALID && strstr(err.message, "no \"auto\""));
+    patch = cJSON_Parse("{\"level\": \"automatic\"}");
+    SL_CHECK(sl_params_apply_json(&q, patch, &err) == SL_ERR_INVALID && strstr(err.message, "or \"auto\""));
+    cJSON_Delete(patch);
+    SL_CHECK(memcmp(&q, &p, sizeof q) == 0);
+}
+
 int main(void)
 {
+    test_auto_float();
     test_techniques();
     test_private_schema();
     test_numeric_enum();
