@@ -120,10 +120,13 @@ void sl_catalog_describe(const sl_dataset *ds, char **bounds, char **counts, cha
         for (int k = 0; k < SL_VOLUME_HISTOGRAM_BINS; k++)
             bins[k] = (double)ds->volume.histogram[k];
         cJSON_AddItemToObject(c, "histogram", cJSON_CreateDoubleArray(bins, SL_VOLUME_HISTOGRAM_BINS));
-        int n = sl_volume_tf_auto_opacity(&ds->volume, ramp);
+        int n = sl_volume_tf_auto_opacity(&ds->volume, 1, ramp); /* the composite ramp: the default mode's */
         cJSON *a_ramp = cJSON_AddArrayToObject(c, "auto_opacity");
         for (int k = 0; a_ramp && k < n; k++)
             cJSON_AddItemToArray(a_ramp, cJSON_CreateDoubleArray(ramp[k], 2));
+        double iso = sl_volume_auto_isovalue(&ds->volume);
+        if (isfinite(iso))
+            cJSON_AddNumberToObject(c, "auto_isovalue", iso);
     }
     *bounds = cJSON_PrintUnformatted(b);
     *counts = cJSON_PrintUnformatted(c);

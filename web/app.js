@@ -130,7 +130,8 @@ function attributeNames() {
 function datasetContext() {
   const c = datasetByName(app.state?.dataset)?.counts || {};
   const list = (x) => (Array.isArray(x) ? x : null);
-  return { valueRange: list(c.value_range), histogram: list(c.histogram), autoOpacity: list(c.auto_opacity) };
+  return { valueRange: list(c.value_range), histogram: list(c.histogram), autoOpacity: list(c.auto_opacity),
+    autoIsovalue: Number.isFinite(c.auto_isovalue) ? c.auto_isovalue : null };
 }
 
 function buildParams() {

@@ -126,7 +126,7 @@ export class ParamControls {
   // opacity ramp, for transfer-function editors).
   build(schema, attributes = null, context = {}) {
     const key = JSON.stringify([schema.map((d) => [d.name, d.type]), attributes, context.valueRange || null,
-      context.histogram || null, context.autoOpacity || null]);
+      context.histogram || null, context.autoOpacity || null, context.autoIsovalue ?? null]);
     if (key === this.schemaKey) return;
     this.schemaKey = key;
     // A rebuild (the catalog told more of the dataset, say) keeps what the
@@ -146,7 +146,11 @@ export class ParamControls {
       row.title = def.description || '';
       const name = document.createElement('span');
       name.className = 'name';
-      name.textContent = def.name;
+      // In full, wrapped at the underscores (the control's name stays def.name).
+      def.name.split('_').forEach((part, k) => {
+        if (k) name.append('_', document.createElement('wbr'));
+        name.append(part);
+      });
       row.append(name);
       let entry;
       if (def.type === 'int' && def.unit === 'sets') {
@@ -214,7 +218,30 @@ export class ParamControls {
         slider.addEventListener('input', () => { out.textContent = fmt(slider.value, 'float'); });
         slider.addEventListener('change', () => this.onChange(def.name, Number(slider.value)));
         row.append(slider, out, range);
-        entry = { def, set: (v) => { slider.value = v; out.textContent = fmt(v, 'float'); } };
+        // "auto" (a schema default of "auto"): the value the server picks for
+        // this dataset when the catalog says it, the slider put there.
+        const autoValue = Number.isFinite(this.context.autoIsovalue) ? this.context.autoIsovalue : null;
+        if (def.default === 'auto') {
+          const back = document.createElement('button');
+          back.type = 'button';
+          back.className = 'auto';
+          back.name = `${def.name}.auto`;
+          back.textContent = 'auto';
+          back.title = 'back to the value the server picks for this dataset';
+          back.addEventListener('click', (e) => { e.preventDefault(); this.onChange(def.name, 'auto'); });
+          range.append(' ', back);
+        }
+        entry = { def, set: (v) => {
+          if (v === 'auto') {
+            if (autoValue !== null) slider.value = autoValue;
+            out.textContent = autoValue !== null ? `auto ${fmt(autoValue, 'float')}` : 'auto';
+            slider.dataset.auto = '1';
+            return;
+          }
+          delete slider.dataset.auto;
+          slider.value = v;
+          out.textContent = fmt(v, 'float');
+        } };
       } else if ((def.type === 'float' || def.type === 'int') && def.max - def.min > WIDE_RANGE) {
         const f = document.createElement('input');
         f.type = 'number';
@@ -229,7 +256,9 @@ export class ParamControls {
         range.className = 'range';
         range.textContent = `${fmt(def.min, def.type)} … ${fmt(def.max, def.type)}${def.unit ? ` ${def.unit}` : ''}`;
         f.title = `${def.description ? `${def.description}. ` : ''}Range ${range.textContent}`;
+        if (def.default === 'auto') f.placeholder = 'auto';
         f.addEventListener('change', () => {
+          if (f.value === '' && def.default === 'auto') { this.onChange(def.name, 'auto'); return; }
           if (f.value === '' || !Number.isFinite(Number(f.value))) return;
           let v = clamp(Number(f.value), def.min, def.max);
           if (def.type === 'int') v = Math.round(v);
@@ -237,7 +266,7 @@ export class ParamControls {
           this.onChange(def.name, v);
         });
         row.append(f, unit, range);
-        entry = { def, set: (v) => { f.value = v; } };
+        entry = { def, set: (v) => { f.value = v === 'auto' ? '' : v; } };
       } else if (def.type === 'float' || def.type === 'int') {
         const sc = scaleFor(def);
         const slider = document.createElement('input');

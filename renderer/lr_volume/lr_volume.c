@@ -121,6 +121,7 @@ typedef struct lr_volume_state {
     sl_volume proxy;               /* value range and histogram only (no voxels) */
     sl_volume_tf_table *table;
     sl_transfer_function tf_loaded;
+    int tf_emission_absorption;    /* composite (1) or mip (0): the automatic ramp differs */
     int tf_valid;
     size_t visible_elements;
     double ref;                    /* the smallest element side (world) */
@@ -189,11 +190,16 @@ static sl_status build_proxy(lr_volume_state *s, sl_err *err)
     }
     sl_volume *pv = &s->proxy;
     memset(pv, 0, sizeof *pv);
-    pv->dims[0] = pv->dims[1] = pv->dims[2] = PROXY_N;
+    /* No voxels: dims and spacing describe the domain in cells of side
+     * s->ref, the length opacity is per here, which is all the automatic
+     * ramp's optical-depth bound reads of them (sl_volume_tf_ramp_depth). */
     pv->components = 1;
     pv->type = SL_VOXEL_F32;
-    for (int a = 0; a < 3; a++)
-        pv->spacing[a] = (lr->domain_hi[a] - lr->domain_lo[a]) / (PROXY_N - 1);
+    for (int a = 0; a < 3; a++) {
+        double cells = (lr->domain_hi[a] - lr->domain_lo[a]) / s->ref;
+        pv->dims[a] = cells < 1.0 ? 1 : cells > 1e6 ? 1000000 : (int)lround(cells);
+        pv->spacing[a] = s->ref;
+    }
     double lo = lr->value_min, hi = lr->value_max;
     for (size_t i = 0; i < n; i++)
         if (isfinite(v[i])) {
@@ -292,12 +298,14 @@ static sl_status program_for(lr_volume_state *s, int mode, GLuint *out, sl_err *
 }
 
 /* Re-bakes the transfer function and the per-element visibility when it changed. */
-static void update_tf(lr_volume_state *s, const sl_transfer_function *tf)
+static void update_tf(lr_volume_state *s, const sl_transfer_function *tf, int emission_absorption)
 {
-    if (s->tf_valid && sl_transfer_function_equal(tf, &s->tf_loaded))
+    if (s->tf_valid && sl_transfer_function_equal(tf, &s->tf_loaded) &&
+        (!tf->auto_opacity || emission_absorption == s->tf_emission_absorption))
         return;
     sl_volume_tf_points pts;
-    sl_volume_tf_resolve(tf, &s->proxy, &pts);
+    sl_volume_tf_resolve(tf, &s->proxy, emission_absorption, &pts);
+    s->tf_emission_absorption = emission_absorption;
     sl_volume_tf_bake(&pts, s->table);
     sl_volume_tf_texture_upload(s->tf_tex, s->table);
     GLuint *vis = malloc(sizeof(GLuint) * s->bz.element_count);
@@ -338,7 +346,7 @@ static sl_status lr_volume_render(void *opaque, const sl_view *view, const sl_pa
     }
     if (over && (st = lrv_streamlines_draw(&s->streamlines, view, params, target, stats, err)) != SL_OK)
         return st;
-    update_tf(s, sl_params_transfer(params, "transfer_function"));
+    update_tf(s, sl_params_transfer(params, "transfer_function"), mode == 0);
     if (view->height > s->rows_capacity) {
         if (s->rows_buf)
             glDeleteBuffers(1, &s->rows_buf);

@@ -188,10 +188,7 @@ static sl_status resolve_isovalues(const sl_volume *vol, const sl_params *params
     int n = sl_params_values(params, "isovalues", iso);
     double lo = vol->value_min, hi = vol->value_max;
     if (n == 0) {
-        double ramp[4][2];
-        sl_volume_tf_auto_opacity(vol, ramp);
-        double t = ramp[0][0] > 0.0 && ramp[0][0] < 1.0 ? ramp[0][0] : 0.5;
-        iso[0] = lo + t * (hi - lo);
+        iso[0] = sl_volume_auto_isovalue(vol);
         n = 1;
     }
     for (int k = 0; k < n; k++)

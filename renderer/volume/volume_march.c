@@ -88,10 +88,13 @@ sl_status sl_volume_marcher_init(sl_volume_marcher *m, const sl_volume *data, sl
  * rule (mode), the TF (composite) or the isovalue (iso) changed. */
 static void update_tf_and_mask(sl_volume_marcher *m, sl_volume_bricks *b, const sl_volume_march_desc *d)
 {
-    int tf_changed = !m->tf_valid || !sl_transfer_function_equal(d->tf, &m->tf_loaded);
+    int emission_absorption = d->mode == SL_VOLUME_MARCH_COMPOSITE; /* the automatic ramp differs */
+    int tf_changed = !m->tf_valid || !sl_transfer_function_equal(d->tf, &m->tf_loaded) ||
+                     (d->tf->auto_opacity && emission_absorption != m->tf_emission_absorption);
     if (tf_changed) {
         sl_volume_tf_points pts;
-        sl_volume_tf_resolve(d->tf, m->data, &pts);
+        sl_volume_tf_resolve(d->tf, m->data, emission_absorption, &pts);
+        m->tf_emission_absorption = emission_absorption;
         sl_volume_tf_bake(&pts, m->table);
         sl_volume_tf_texture_upload(m->tf_tex, m->table);
         m->tf_loaded = *d->tf;

@@ -50,7 +50,7 @@ static double smoothed(const uint64_t *h, int k)
     return sum / n;
 }
 
-int sl_volume_tf_auto_opacity(const sl_volume *vol, double ramp[4][2])
+int sl_volume_tf_auto_opacity(const sl_volume *vol, int emission_absorption, double ramp[4][2])
 {
     const int bins = SL_VOLUME_HISTOGRAM_BINS;
     const uint64_t *h = vol->histogram;
@@ -95,10 +95,53 @@ int sl_volume_tf_auto_opacity(const sl_volume *vol, double ramp[4][2])
     ramp[n][0] = t0, ramp[n++][1] = 0.0;
     ramp[n][0] = 0.5 * (t0 + t1), ramp[n++][1] = SL_VOLUME_AUTO_ALPHA * SL_VOLUME_AUTO_MID;
     ramp[n][0] = t1, ramp[n++][1] = SL_VOLUME_AUTO_ALPHA;
+    /* Bound the optical depth (see sl_volume.h): scale every extinction
+     * -ln(1 - alpha) by one factor, which scales the estimate exactly. */
+    double depth = emission_absorption ? sl_volume_tf_ramp_depth(vol, ramp, n) : 0.0;
+    if (depth > SL_VOLUME_AUTO_DEPTH) {
+        double scale = SL_VOLUME_AUTO_DEPTH / depth;
+        for (int k = 0; k < n; k++)
+            ramp[k][1] = -expm1(scale * log1p(-ramp[k][1]));
+    }
     return n;
 }
 
-void sl_volume_tf_resolve(const sl_transfer_function *given, const sl_volume *vol, sl_volume_tf_points *out)
+double sl_volume_tf_ramp_depth(const sl_volume *vol, const double ramp[][2], int n)
+{
+    const uint64_t *h = vol->histogram;
+    sl_transfer_function tf = {.colormap = -1, .count = n};
+    for (int k = 0; k < n; k++)
+        tf.point[k][0] = ramp[k][0], tf.point[k][1] = ramp[k][1];
+    double seen = 0.0, extinction = 0.0; /* over the voxels the ramp makes visible */
+    for (int k = 0; k < SL_VOLUME_HISTOGRAM_BINS; k++) {
+        double alpha = ramp_alpha(&tf, (k + 0.5) / SL_VOLUME_HISTOGRAM_BINS);
+        if (alpha <= 0.0 || h[k] == 0)
+            continue;
+        seen += (double)h[k];
+        extinction += (double)h[k] * -log1p(-fmin(alpha, 0.999999));
+    }
+    if (!(seen > 0.0))
+        return 0.0;
+    /* The visible share of the box (in cells of the volume's spacing), in
+     * cubes of the smallest spacing (the unit of alpha), as a ball. */
+    double unit = fmin(fmin(vol->spacing[0], vol->spacing[1]), vol->spacing[2]);
+    double cubes = seen / (double)vol->finite_count;
+    for (int a = 0; a < 3; a++)
+        cubes *= vol->dims[a] * (unit > 0.0 ? vol->spacing[a] / unit : 1.0);
+    double chord = cbrt(6.0 * cubes / M_PI); /* the diameter of that ball */
+    return chord * extinction / seen;
+}
+
+double sl_volume_auto_isovalue(const sl_volume *vol)
+{
+    double ramp[4][2];
+    sl_volume_tf_auto_opacity(vol, 1, ramp);
+    double t = ramp[0][0] > 0.0 && ramp[0][0] < 1.0 ? ramp[0][0] : 0.5;
+    return vol->value_min + t * (vol->value_max - vol->value_min);
+}
+
+void sl_volume_tf_resolve(const sl_transfer_function *given, const sl_volume *vol, int emission_absorption,
+                          sl_volume_tf_points *out)
 {
     memset(out, 0, sizeof *out);
     double value_min = vol->value_min, value_max = vol->value_max;
@@ -107,7 +150,7 @@ void sl_volume_tf_resolve(const sl_transfer_function *given, const sl_volume *vo
     if (given->auto_opacity) {
         double ramp[4][2] = {{0}};
         with_ramp = *given;
-        with_ramp.count = sl_volume_tf_auto_opacity(vol, ramp);
+        with_ramp.count = sl_volume_tf_auto_opacity(vol, emission_absorption, ramp);
         /* The ramp's t spans the value range; a given range re-maps it. */
         double span = value_max > value_min ? value_max - value_min : 1.0;
         for (int k = 0; k < with_ramp.count; k++) {

@@ -31,8 +31,9 @@ static const sl_param_def volume_dvr_params[] = {
     {"mode", SL_PARAM_ENUM, 0, 0, {0}, mode_names, "",
      "composite (emission-absorption), mip (maximum intensity), iso (first crossing of isovalue, shaded)",
      SL_INVALIDATE_FRAME},
-    {"isovalue", SL_PARAM_FLOAT, -1e30, 1e30, {0.5}, NULL, "data", "iso mode: the surface's value",
-     SL_INVALIDATE_FRAME},
+    {"isovalue", SL_PARAM_FLOAT, -1e30, 1e30, {SL_PARAM_AUTO}, NULL, "data",
+     "iso mode: the surface's value; auto: where the histogram's background peak ends (the object's boundary), "
+     "mid-range without one", SL_INVALIDATE_FRAME},
     {"step", SL_PARAM_FLOAT, 0.01, 16.0, {0.5}, NULL, "voxel",
      "sampling distance in units of the smallest voxel spacing (opacity is corrected for it)", SL_INVALIDATE_FRAME},
     {"jitter", SL_PARAM_BOOL, 0, 1, {1}, NULL, "", "per-pixel random start within a step (against wood-grain)",
@@ -126,7 +127,8 @@ static sl_status volume_dvr_render(void *opaque, const sl_view *view, const sl_p
         .mode = (sl_volume_march_mode)sl_params_choice(params, "mode"),
         .tf = sl_params_transfer(params, "transfer_function"),
         .step = sl_params_float(params, "step"),
-        .iso = sl_params_float(params, "isovalue"),
+        .iso = sl_params_is_auto(params, "isovalue") ? sl_volume_auto_isovalue(&s->dataset->volume)
+                                                      : sl_params_float(params, "isovalue"),
         .alpha_stop = sl_params_float(params, "alpha_threshold"),
         .jitter = sl_params_bool(params, "jitter"),
         .no_skipping = !sl_params_bool(params, "empty_space_skipping"),

@@ -378,6 +378,7 @@ async function driveControls(page, obs, sess, saved) {
   // dataset of another kind switches to the first technique that accepts it,
   // in one scene message (no error), and a frame of it arrives.
   await volumeScene(page, obs, sess, banner);
+  await firstLook(page, obs, sess, banner);
   await particlesTf2d(page, obs, sess, banner);
 
   // Load view: the saved view's dataset, technique, params and camera return.
@@ -535,6 +536,66 @@ async function volumeScene(page, obs, sess, banner) {
   const mh = await histogramPixels();
   check(mh > 0.05, `the MRI's histogram is behind its editor (${(100 * mh).toFixed(1)} %)`);
   await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-volume.png') });
+}
+
+// The first look (issue 31, part 4): the built-in head with volume_dvr on
+// its defaults. The automatic opacity ramp and the automatic isovalue the
+// page shows lie inside the value range and above the background peak (the
+// largest bin of the histogram's lower half: the air around the head), the
+// isovalue's "auto" button gives the server "auto" back, and no parameter
+// name in the panel is cut (each fits its cell). The screenshot is
+// browser-test-first-look.png.
+async function firstLook(page, obs, sess, banner) {
+  await page.selectOption('#dataset', 'head');
+  check(await serverStateWhere(obs, sess, (s) => s.dataset === 'head' && Array.isArray(s.bounds), 'head', 60000),
+    'head loaded');
+  await page.waitForFunction(() => {
+    const c = window.sightline.datasets.find((d) => d.name === 'head')?.counts;
+    return c && Array.isArray(c.histogram) && Array.isArray(c.value_range) && Number.isFinite(c.auto_isovalue);
+  }, null, { timeout: T });
+  const counts = await page.evaluate(() => window.sightline.datasets.find((d) => d.name === 'head').counts);
+  const [lo, hi] = counts.value_range;
+  const h = counts.histogram;
+  let peak = 0;
+  for (let k = 1; k < h.length / 2; k++) if (h[k] > h[peak]) peak = k;
+  const peakEnd = lo + (peak + 1) / h.length * (hi - lo);   // the upper edge of the background bin
+  const schema = await page.evaluate(() => window.sightline.techniques.find((t) => t.name === window.sightline.state.technique).params);
+  const iso = schema.find((d) => d.name === 'isovalue');
+  check(iso && iso.default === 'auto', `the isovalue's default is "auto" (${iso && JSON.stringify(iso.default)})`);
+  const tfDef = schema.find((d) => d.type === 'transfer_function');
+  check(tfDef && tfDef.default.opacity === 'auto', `the transfer function's default opacity is "auto"`);
+  // Back to the defaults through the page: the isovalue's auto button, the TF's auto preset.
+  await page.click(`#params button[name="isovalue.auto"]`);
+  await page.selectOption(`#params select[name="${tfDef.name}.preset"]`, '@auto');
+  const st = await serverStateWhere(obs, sess, (s) => s.params.isovalue === 'auto' && s.params[tfDef.name].opacity === 'auto',
+    'auto isovalue and opacity');
+  check(st, `the server has isovalue "auto" and the automatic opacity (${st && JSON.stringify(st.params.isovalue)})`);
+  await settled(page);
+  const shown = await page.$eval('#params input[type=range][name=isovalue]', (x) => ({ value: Number(x.value),
+    out: x.parentElement.querySelector('output').textContent, min: Number(x.min), max: Number(x.max) }));
+  const autoIso = counts.auto_isovalue;
+  check(shown.out.startsWith('auto') && Math.abs(shown.value - autoIso) <= 1e-6 * (hi - lo),
+    `the page shows the automatic isovalue ${autoIso} (slider ${shown.value}, "${shown.out}")`);
+  check(autoIso > lo && autoIso < hi && autoIso > peakEnd,
+    `the automatic isovalue ${autoIso} lies inside ${lo} … ${hi} and above the background peak (ends at ${peakEnd})`);
+  check(shown.min === lo && shown.max === hi, `the isovalue slides over the value range (${shown.min} … ${shown.max})`);
+  const ramp = counts.auto_opacity;
+  const values = ramp.map(([t]) => lo + t * (hi - lo));
+  check(ramp.length >= 2 && values.every((v) => v >= lo && v <= hi) && values[0] > peakEnd && ramp[0][1] === 0 &&
+    ramp[ramp.length - 1][1] > 0, `the automatic opacity starts above the background peak and stays in range ` +
+    `(${JSON.stringify(ramp)} -> values ${values.map((v) => v.toFixed(1))})`);
+  await page.waitForFunction(() => window.sightline.lastFrame && !window.sightline.lastFrame.interactive &&
+    window.sightline.lastFrame.stateVersion >= window.sightline.stateVersion, null, { timeout: 3 * T });
+  const fr = await canvasStats(page);
+  check(fr.fg > 0.05 && fr.fg < 0.95, `the head shows (foreground ${fr.fg.toFixed(3)})`);
+  check((await banner()) === '', `no error on the head (${await banner()})`);
+  const cut = await page.$$eval('#params .param .name', (ns) => ns.filter((n) => n.scrollWidth > n.clientWidth + 1)
+    .map((n) => n.textContent));
+  check(cut.length === 0, `no parameter name is cut (${JSON.stringify(cut)})`);
+  const vecCut = await page.$$eval('#params input.vec', (fs) => fs.filter((f) => f.scrollWidth > f.clientWidth + 1)
+    .map((f) => `${f.name}=${f.value}`));
+  check(vecCut.length === 0, `no vector component is cut (${JSON.stringify(vecCut)})`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'browser-test-first-look.png') });
 }
 
 // particles on Marschner-Lobb: the transfer_2d entry is the 2D editor of

@@ -155,7 +155,7 @@ file(MAKE_DIRECTORY ${SL_RENDER_OUT}/volume_dvr)
 volume_test(goldens
   ${CMAKE_COMMAND}
   "-DSTEP1=$<TARGET_FILE:sightline-regress>|${VOLUME_DIR}/goldens|--out|${SL_RENDER_OUT}/volume_dvr/goldens|--jobs|2|--junit|${SL_RENDER_OUT}/volume_dvr/goldens.xml"
-  "-DOUT1=3 cases, 3 passed, 0 failed, 0 errors"
+  "-DOUT1=6 cases, 6 passed, 0 failed, 0 errors"
   ${SL_STEPS})
 
 # sightline-info counts NaN voxels (f32): a 2x2x1 raw volume with two NaN,

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "data/sl_dataset.h"
+#include "data/sl_generate.h"
 #include "volume/sl_volume.h"
 #include "sl_test.h"
 
@@ -138,14 +139,16 @@ static int ramp_of(const uint64_t *h, double ramp[4][2])
         v.histogram[k] = h[k];
         v.finite_count += h[k];
     }
-    return sl_volume_tf_auto_opacity(&v, ramp);
+    return sl_volume_tf_auto_opacity(&v, 1, ramp);
 }
 
-/* A valid ramp: 1..4 points, t in [0, 1] non-decreasing, alpha in [0, 1],
- * starting at 0 and ending at SL_VOLUME_AUTO_ALPHA. */
+/* A valid ramp: 1..4 points, t in [0, 1] increasing, alpha in [0, 1],
+ * starting at 0 and ending above 0 at most at SL_VOLUME_AUTO_ALPHA (less
+ * where the optical-depth bound scaled it down). */
 static void check_ramp(const double ramp[4][2], int n, const char *what)
 {
-    int ok = n >= 2 && n <= 4 && ramp[0][1] == 0.0 && ramp[n - 1][1] == SL_VOLUME_AUTO_ALPHA;
+    int ok = n >= 2 && n <= 4 && ramp[0][1] == 0.0 && ramp[n - 1][1] > 0.0 &&
+             ramp[n - 1][1] <= SL_VOLUME_AUTO_ALPHA;
     for (int k = 0; k < n && ok; k++)
         ok = ramp[k][0] >= 0.0 && ramp[k][0] <= 1.0 && ramp[k][1] >= 0.0 && ramp[k][1] <= 1.0 &&
              (k == 0 || ramp[k][0] > ramp[k - 1][0]);
@@ -216,7 +219,7 @@ static void test_resolve_auto(void)
     if (!ds)
         return;
     double ramp[4][2];
-    int n = sl_volume_tf_auto_opacity(&ds->volume, ramp);
+    int n = sl_volume_tf_auto_opacity(&ds->volume, 1, ramp);
     check_ramp(ramp, n, "zeros then 40..63");
     SL_CHECK_MSG(ramp[0][0] > 0.0, "the zeros were not taken as background (t %g)", ramp[0][0]);
     sl_transfer_function autotf, explicit;
@@ -229,15 +232,15 @@ static void test_resolve_auto(void)
     for (int k = 0; k < n; k++)
         explicit.point[k][0] = ramp[k][0], explicit.point[k][1] = ramp[k][1];
     sl_volume_tf_points a, b;
-    sl_volume_tf_resolve(&autotf, &ds->volume, &a);
-    sl_volume_tf_resolve(&explicit, &ds->volume, &b);
+    sl_volume_tf_resolve(&autotf, &ds->volume, 1, &a);
+    sl_volume_tf_resolve(&explicit, &ds->volume, 1, &b);
     SL_CHECK(a.count == b.count && memcmp(a.value, b.value, sizeof a.value) == 0 &&
              memcmp(a.rgba, b.rgba, sizeof a.rgba) == 0);
     /* With a range twice as wide, the same values keep their opacity. */
     autotf.has_range = 1;
     autotf.range[0] = -63.0;
     autotf.range[1] = 63.0;
-    sl_volume_tf_resolve(&autotf, &ds->volume, &a);
+    sl_volume_tf_resolve(&autotf, &ds->volume, 1, &a);
     int same = 1;
     for (double v = 0.0; v <= 63.0; v += 0.5) {
         double ra[4], rb[4];
@@ -249,10 +252,111 @@ static void test_resolve_auto(void)
     sl_dataset_destroy(ds);
 }
 
+/* The optical-depth bound, checked by brute force: a ball of radius R
+ * voxels of one value (1) in a background of zeros, with a shell of a
+ * higher value (2) around it; the extinction -ln(1 - alpha) of every voxel
+ * on the line through the centre, summed (unit spacing: the unit of
+ * alpha), is the ray's optical depth. Without the bound it would be about
+ * R * 0.2 (ball at mid-ramp, ~0.025) plus the shell's; with it, it stays
+ * within SL_VOLUME_AUTO_DEPTH and is not cut far below it. */
+static void test_depth_bound(void)
+{
+    enum { N = 96 };
+    const double R = 36.0, shell = 3.0, c = 0.5 * (N - 1);
+    sl_err err = {0};
+    sl_dataset *ds = sl_dataset_create(SL_DATASET_VOLUME, "ball");
+    int dims[3] = {N, N, N};
+    SL_CHECK(ds && sl_volume_alloc(&ds->volume, dims, 1, SL_VOXEL_F32, &err) == SL_OK);
+    if (!ds || !ds->volume.data) {
+        sl_dataset_destroy(ds);
+        return;
+    }
+    float *v = ds->volume.data;
+    for (int z = 0; z < N; z++)
+        for (int y = 0; y < N; y++)
+            for (int x = 0; x < N; x++) {
+                double r = sqrt((x - c) * (x - c) + (y - c) * (y - c) + (z - c) * (z - c));
+                v[((size_t)z * N + y) * N + x] = r < R ? 1.0f : r < R + shell ? 2.0f : 0.0f;
+            }
+    SL_CHECK(sl_dataset_finish_volume(ds, &err) == SL_OK);
+    double ramp[4][2];
+    int n = sl_volume_tf_auto_opacity(&ds->volume, 1, ramp);
+    check_ramp(ramp, n, "ball in a shell");
+    SL_CHECK_MSG(ramp[n - 1][1] < SL_VOLUME_AUTO_ALPHA, "the bound did not scale this ramp (top alpha %g)",
+                 ramp[n - 1][1]);
+    sl_transfer_function tf;
+    memset(&tf, 0, sizeof tf);
+    tf.colormap = 0;
+    tf.auto_opacity = 1;
+    sl_volume_tf_points pts;
+    sl_volume_tf_resolve(&tf, &ds->volume, 1, &pts);
+    double depth = 0.0;
+    int y = N / 2, z = N / 2;
+    for (int x = 0; x < N; x++) {
+        double rgba[4];
+        sl_volume_tf_eval(&pts, v[((size_t)z * N + y) * N + x], rgba);
+        depth += -log1p(-rgba[3]);
+    }
+    printf("ball R %g + shell %g: optical depth through the centre %.3f (bound %g), estimate %.3f\n", R, shell,
+           depth, SL_VOLUME_AUTO_DEPTH, sl_volume_tf_ramp_depth(&ds->volume, ramp, n));
+    /* MIP (one sample per ray) keeps the unbounded ramp. */
+    double mip[4][2];
+    int nm = sl_volume_tf_auto_opacity(&ds->volume, 0, mip);
+    SL_CHECK_MSG(nm == n && mip[nm - 1][1] == SL_VOLUME_AUTO_ALPHA && mip[0][0] == ramp[0][0],
+                 "the MIP ramp: top alpha %g, start %g (composite %g)", mip[nm - 1][1], mip[0][0], ramp[0][0]);
+    SL_CHECK_MSG(depth <= SL_VOLUME_AUTO_DEPTH * 1.05 && depth >= 0.5 * SL_VOLUME_AUTO_DEPTH,
+                 "optical depth %g through the centre, bound %g", depth, SL_VOLUME_AUTO_DEPTH);
+    sl_dataset_destroy(ds);
+}
+
+/* The head phantom (CT-like, 96^3 here): its soft tissue and brain fill
+ * most of the head, so the unbounded ramp hides everything inside the
+ * skull (the uniform egg of issue 31). The bounded ramp keeps its estimate
+ * at SL_VOLUME_AUTO_DEPTH, and the optical depth of the ray through the
+ * centre, summed voxel by voxel, stays below the estimate (a shell is
+ * crossed over fewer voxels than the ball the estimate assumes). */
+static void test_head_first_look(void)
+{
+    sl_err err = {0};
+    sl_dataset *ds = NULL;
+    SL_CHECK(sl_generate_json("{\"generator\": \"head\", \"size\": 96}", &ds, &err) == SL_OK);
+    if (!ds)
+        return;
+    const sl_volume *vol = &ds->volume;
+    double open[4][2], bounded[4][2];
+    int n = sl_volume_tf_auto_opacity(vol, 0, open);
+    int nb = sl_volume_tf_auto_opacity(vol, 1, bounded);
+    double d_open = sl_volume_tf_ramp_depth(vol, open, n), d_bounded = sl_volume_tf_ramp_depth(vol, bounded, nb);
+    sl_transfer_function tf;
+    memset(&tf, 0, sizeof tf);
+    tf.colormap = 0;
+    tf.auto_opacity = 1;
+    sl_volume_tf_points pts;
+    sl_volume_tf_resolve(&tf, vol, 1, &pts);
+    double centre = 0.0;
+    const uint16_t *v = vol->data;
+    int N = vol->dims[0], y = N / 2, z = N / 2;
+    for (int x = 0; x < N; x++) {
+        double rgba[4];
+        sl_volume_tf_eval(&pts, v[((size_t)z * N + y) * N + x], rgba);
+        centre += -log1p(-rgba[3]);
+    }
+    printf("head 96^3: ramp start %.1f, top alpha %.3f -> %.4f; estimated depth %.2f -> %.2f, "
+           "centre ray %.2f\n", vol->value_min + bounded[0][0] * (vol->value_max - vol->value_min), open[n - 1][1],
+           bounded[nb - 1][1], d_open, d_bounded, centre);
+    SL_CHECK_MSG(d_open > 2.0 * SL_VOLUME_AUTO_DEPTH, "the unbounded head ramp is not deep (%g)", d_open);
+    /* Extinctions scale exactly at the ramp's points; between them alpha is linear: within 5 %. */
+    SL_CHECK_MSG(fabs(d_bounded - SL_VOLUME_AUTO_DEPTH) < 0.05 * SL_VOLUME_AUTO_DEPTH, "bounded estimate %g", d_bounded);
+    SL_CHECK_MSG(centre <= d_bounded && centre > 0.1, "centre ray depth %g, estimate %g", centre, d_bounded);
+    sl_dataset_destroy(ds);
+}
+
 int main(void)
 {
     test_histograms();
     test_auto_opacity();
     test_resolve_auto();
+    test_depth_bound();
+    test_head_first_look();
     SL_TEST_END();
 }
