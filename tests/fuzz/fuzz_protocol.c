@@ -136,6 +136,11 @@ static void check_params(const cJSON *patch)
             int k_count = d->type == SL_PARAM_VEC3 ? 3 : 1;
             for (int k = 0; k < k_count; k++) {
                 double v = p.value[i][k];
+                if (d->type == SL_PARAM_FLOAT && isnan(v)) { /* only "auto", only where the default is auto */
+                    if (!sl_param_def_has_auto(d) || !sl_params_is_auto(&p, d->name))
+                        abort();
+                    continue;
+                }
                 if ((d->type == SL_PARAM_FLOAT || d->type == SL_PARAM_INT || d->type == SL_PARAM_VEC3 ||
                      d->type == SL_PARAM_ATTRIBUTE) && !(v >= d->min && v <= d->max))
                     abort();

@@ -247,6 +247,11 @@ static int compare(const options *o)
         rig_deinit(&r);
         return 2;
     }
+    if (sl_params_choice(&r.params, "mode") == 2 && sl_params_is_auto(&r.params, "isovalue")) {
+        fprintf(stderr, "volume-check: give the isovalue as a number (the reference resolves no \"auto\")\n");
+        rig_deinit(&r);
+        return 2;
+    }
     sl_view view;
     if (!make_view(ds, o->orbit, o->size, &view, &err)) {
         fprintf(stderr, "volume-check: %s\n", err.message);
