@@ -19,7 +19,8 @@
 /* Curves and caps go to Embree this much fatter: its float intersector drops rays that graze a
  * tube within ~1e-5 r (random set seed 2: a rim ray 3e-5 r inside the sweep missed, so the
  * tube behind showed, 8.8 r deeper). Every candidate is then decided on the true sweep in
- * double: refined, or, where the ray misses it, traced on. */
+ * double: refined, or, where the ray misses it, traced on. Exact pieces' boxes are as fat (the
+ * float ray finds them), their intersection is the true sweep's with the double ray. */
 #define INFLATE 1.02
 #define END_T 1e-7 /* a hit parameter this close to a piece's end is at the end */
 
@@ -218,30 +219,38 @@ static void exact_bounds(const struct RTCBoundsFunctionArguments *args)
 enum { RAY_ORG = 0, RAY_TNEAR = 3, RAY_DIR = 4, RAY_TFAR = 8, RAY_FLOATS = 12, HIT_NG = 0, HIT_U = 3, HIT_V = 4,
        HIT_PRIM = 5, HIT_GEOM = 6, HIT_INST = 7 };
 
+/* Every trace's context: Embree's, then the double rays the float ones stand for (by ray id)
+ * and, per ray, the last entry an exact primitive reported. */
+typedef struct trace_context {
+    struct RTCIntersectContext embree; /* first: Embree hands the callbacks this pointer */
+    const double *eye;
+    const double (*dirs)[3];
+    double tnear[16];                  /* the double ray starts here */
+    double exact_l[16], exact_t[16];
+} trace_context;
+
+enum { RAY_ID = 10 };
+
+/* Exact primitives are decided at once on the true sweep with the pixel's double ray: their
+ * reported entry is the true one (rounded to float), so they need no inflation, and a trace
+ * that starts past a candidate (tnear) sees the next true entry. */
 static void exact_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const sl_tubes_embree *e = args->geometryUserPtr;
+    trace_context *tc = (trace_context *)args->context;
     unsigned n = args->N;
     float *ray = (float *)args->rayhit;
+    uint32_t *ray_u = (uint32_t *)ray;
     float *hit = ray + RAY_FLOATS * n;
     uint32_t *hit_u = (uint32_t *)hit;
-    /* the candidate test on the inflated sweep (as the curves): the float ray may miss a rim
-     * that the double ray hits; resolve_pixel decides on the true sweep in double */
-    sl_tubes_sweep fat = e->pieces[e->exact_piece[args->primID]].sweep;
-    for (int k = 0; k < 3; k++)
-        fat.r[k] *= INFLATE;
-    const sl_tubes_sweep *s = &fat;
+    const sl_tubes_sweep *s = &e->pieces[e->exact_piece[args->primID]].sweep;
     for (unsigned i = 0; i < n; i++) {
         if (!args->valid[i])
             continue;
-        double o[3] = {ray[(RAY_ORG + 0) * n + i], ray[(RAY_ORG + 1) * n + i], ray[(RAY_ORG + 2) * n + i]};
-        double d[3] = {ray[(RAY_DIR + 0) * n + i], ray[(RAY_DIR + 1) * n + i], ray[(RAY_DIR + 2) * n + i]};
+        unsigned id = ray_u[RAY_ID * n + i];
+        const double *o = tc->eye, *d = tc->dirs[id];
         double l, t;
-        /* after a retrace from tnear, the inflated entry may lie before tnear while the true one
-         * lies beyond: then the true one is the candidate */
-        if (!sl_tubes_sweep_intersect(s, o, d, ray[RAY_TNEAR * n + i], ray[RAY_TFAR * n + i], &l, &t) &&
-            !sl_tubes_sweep_intersect(&e->pieces[e->exact_piece[args->primID]].sweep, o, d, ray[RAY_TNEAR * n + i],
-                                      ray[RAY_TFAR * n + i], &l, &t))
+        if (!sl_tubes_sweep_intersect(s, o, d, tc->tnear[id], ray[RAY_TFAR * n + i], &l, &t))
             continue;
         double c[3], r;
         sl_tubes_sweep_eval(s, t, c, &r);
@@ -253,6 +262,8 @@ static void exact_intersect(const struct RTCIntersectFunctionNArguments *args)
         hit_u[HIT_PRIM * n + i] = args->primID;
         hit_u[HIT_GEOM * n + i] = args->geomID;
         hit_u[HIT_INST * n + i] = args->context->instID[0];
+        tc->exact_l[id] = l;
+        tc->exact_t[id] = t;
     }
 }
 
@@ -566,32 +577,38 @@ static const piece *refine_hit(const sl_tubes_embree *e, const piece *p, const d
     return p;
 }
 
-static void trace_one(const sl_tubes_embree *e, const float org[3], const float dir[3], float tnear, float tfar,
-                      struct RTCRayHit *rh)
+/* One ray from tnear (float, and the double ray's own start) to tfar; an exact primitive's
+ * entry comes back in *exact_l, *exact_t. */
+static void trace_one(const sl_tubes_embree *e, const double eye[3], const double dir[3], float tnear,
+                      double tnear_double, float tfar, struct RTCRayHit *rh, double *exact_l, double *exact_t)
 {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    trace_context ctx = {.eye = eye, .dirs = (const double(*)[3])dir, .tnear = {tnear_double}};
+    rtcInitIntersectContext(&ctx.embree);
     *rh = (struct RTCRayHit){0};
-    rh->ray.org_x = org[0];
-    rh->ray.org_y = org[1];
-    rh->ray.org_z = org[2];
-    rh->ray.dir_x = dir[0];
-    rh->ray.dir_y = dir[1];
-    rh->ray.dir_z = dir[2];
+    rh->ray.org_x = (float)eye[0];
+    rh->ray.org_y = (float)eye[1];
+    rh->ray.org_z = (float)eye[2];
+    rh->ray.dir_x = (float)dir[0];
+    rh->ray.dir_y = (float)dir[1];
+    rh->ray.dir_z = (float)dir[2];
     rh->ray.tnear = tnear;
     rh->ray.tfar = tfar;
     rh->ray.mask = 0xffffffffu;
+    rh->ray.id = 0;
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(e->scene, &ctx, rh);
+    rtcIntersect1(e->scene, &ctx.embree, rh);
+    *exact_l = ctx.exact_l[0];
+    *exact_t = ctx.exact_t[0];
 }
 
 /* A candidate from Embree decided on the true sweep in double: 1 with the entry (*l, *t) on
  * *out; 0 when the ray leaves there (an exit: the ray started inside the sweep) or misses the
- * true sweep (it grazed the inflated one). */
+ * true sweep (it grazed the inflated one). An exact primitive's candidate is its true entry
+ * already (exact_l, exact_t). */
 static int decide_candidate(const sl_tubes_embree *e, const double o[3], const double d[3], double l_min,
-                            unsigned geom, unsigned prim, float u, float tfar, const piece **out, double *l,
-                            double *t, atomic_llong *refined)
+                            unsigned geom, unsigned prim, float u, float tfar, double exact_l, double exact_t,
+                            const piece **out, double *l, double *t, atomic_llong *refined)
 {
     const piece *p = hit_piece(e, geom, prim, u, t);
     *l = tfar;
@@ -611,11 +628,8 @@ static int decide_candidate(const sl_tubes_embree *e, const double o[3], const d
         *l = a - sqrt(disc);
         p = refine_hit(e, p, o, d, l_min, 1, l, t);
     } else {
-        /* the user primitive saw the float ray; at rims the depth is that sensitive to the
-         * ray's lateral position (measured: 0.036 r on the one-pixel tornado tubes), so the
-         * double ray decides again */
-        if (!sl_tubes_sweep_intersect(&p->sweep, o, d, l_min, INFINITY, l, t))
-            return 0;
+        *l = exact_l;
+        *t = exact_t;
         if (*t <= END_T || *t >= 1.0 - END_T) /* an end sphere: the neighbour may hold a nearer entry */
             p = refine_hit(e, p, o, d, l_min, 0, l, t);
     }
@@ -628,20 +642,20 @@ static int decide_candidate(const sl_tubes_embree *e, const double o[3], const d
  * turn until the next lies beyond the best true entry finds the nearest entry. Shades it into
  * the frame (colour and depth; 0: nothing). */
 static void resolve_pixel(frame_job *job, int x, int y, const double d[3], unsigned geom, unsigned prim, float u,
-                          float tfar)
+                          float tfar, double exact_l, double exact_t)
 {
     const sl_tubes_embree *e = job->e;
     size_t at = (size_t)(job->height - 1 - y) * (size_t)job->width + (size_t)x;
     float df = (float)(d[0] * job->forward[0] + d[1] * job->forward[1] + d[2] * job->forward[2]);
     double l_min = job->near_plane / fmax(df, 1e-30);
-    const float org[3] = {(float)job->eye[0], (float)job->eye[1], (float)job->eye[2]};
     const float dir[3] = {(float)d[0], (float)d[1], (float)d[2]};
     const piece *best = NULL;
     double best_l = INFINITY, best_t = 0.0;
     for (int round = 0; round <= MAX_RETRACE && geom != RTC_INVALID_GEOMETRY_ID && tfar < best_l; round++) {
         const piece *p;
         double l, t;
-        int okc = decide_candidate(e, job->eye, d, l_min, geom, prim, u, tfar, &p, &l, &t, &job->refined);
+        int okc = decide_candidate(e, job->eye, d, l_min, geom, prim, u, tfar, exact_l, exact_t, &p, &l, &t,
+                                   &job->refined);
         if (okc && l < best_l) {
             best = p;
             best_l = l;
@@ -650,7 +664,9 @@ static void resolve_pixel(frame_job *job, int x, int y, const double d[3], unsig
         /* the next candidate beyond this one, nearer than the best entry */
         atomic_fetch_add_explicit(&job->retraced, 1, memory_order_relaxed);
         struct RTCRayHit rh;
-        trace_one(e, org, dir, nextafterf(tfar, INFINITY), isfinite(best_l) ? (float)best_l : INFINITY, &rh);
+        float from = nextafterf(tfar, INFINITY);
+        trace_one(e, job->eye, d, from, fmax(from, l_min), isfinite(best_l) ? (float)best_l : INFINITY, &rh,
+                  &exact_l, &exact_t);
         geom = rh.hit.geomID;
         prim = rh.hit.primID;
         u = rh.hit.u;
@@ -697,10 +713,10 @@ static void trace_tile(void *opaque, int tile, int worker)
     int x0 = (tile % job->tiles_x) * TILE, y0 = (tile / job->tiles_x) * TILE;
     int x1 = x0 + TILE < job->width ? x0 + TILE : job->width, y1 = y0 + TILE < job->height ? y0 + TILE : job->height;
     const int n = e->packet, bw = n >= 4 ? (n == 4 ? 2 : 4) : 1, bh = n / bw;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     double dirs[16][3];
+    trace_context ctx = {.eye = job->eye, .dirs = (const double(*)[3])dirs};
+    rtcInitIntersectContext(&ctx.embree);
+    ctx.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (int by = y0; by < y1; by += bh)
         for (int bx = x0; bx < x1; bx += bw) {
             RTC_ALIGN(64) packet16 pk;
@@ -717,7 +733,8 @@ static void trace_tile(void *opaque, int tile, int worker)
                     pk.f[(RAY_ORG + c) * n + i] = (float)job->eye[c];
                     pk.f[(RAY_DIR + c) * n + i] = (float)dirs[i][c];
                 }
-                pk.f[RAY_TNEAR * n + i] = (float)(job->near_plane / fmax(df, 1e-30));
+                ctx.tnear[i] = job->near_plane / fmax(df, 1e-30);
+                pk.f[RAY_TNEAR * n + i] = (float)ctx.tnear[i];
                 pk.f[7 * n + i] = 0.0f;             /* time */
                 pk.f[RAY_TFAR * n + i] = INFINITY;
                 pk.u[9 * n + i] = 0xffffffffu;      /* mask */
@@ -727,18 +744,18 @@ static void trace_tile(void *opaque, int tile, int worker)
                 hit_u[HIT_INST * n + i] = RTC_INVALID_GEOMETRY_ID;
             }
             if (n == 16)
-                rtcIntersect16(valid, e->scene, &ctx, &pk.p16);
+                rtcIntersect16(valid, e->scene, &ctx.embree, &pk.p16);
             else if (n == 8)
-                rtcIntersect8(valid, e->scene, &ctx, &pk.p8);
+                rtcIntersect8(valid, e->scene, &ctx.embree, &pk.p8);
             else if (n == 4)
-                rtcIntersect4(valid, e->scene, &ctx, &pk.p4);
+                rtcIntersect4(valid, e->scene, &ctx.embree, &pk.p4);
             else
-                rtcIntersect1(e->scene, &ctx, (struct RTCRayHit *)pk.f);
+                rtcIntersect1(e->scene, &ctx.embree, (struct RTCRayHit *)pk.f);
             for (int i = 0; i < n; i++) {
                 if (!valid[i])
                     continue;
                 resolve_pixel(job, bx + i % bw, by + i / bw, dirs[i], hit_u[HIT_GEOM * n + i], hit_u[HIT_PRIM * n + i],
-                              hit[HIT_U * n + i], pk.f[RAY_TFAR * n + i]);
+                              hit[HIT_U * n + i], pk.f[RAY_TFAR * n + i], ctx.exact_l[i], ctx.exact_t[i]);
             }
         }
 }

@@ -7,10 +7,12 @@
  * where the root is real; the sweep's entry is the smallest local minimum of l(t) over
  * [0, 1] (the ends count) that lies at or beyond l_min. Rays that start inside a sphere
  * see the next entry beyond l_min, the GL path's rule (tubes_intersect.glsl).
- * sl_tubes_sweep_intersect finds the parameter intervals where the ray meets the spheres
- * exactly (the roots of the quartic r^2 - |q|^2 + (d.q)^2, isolated between the roots of
- * its derivatives), samples l at 33 points of each and polishes every sampled minimum
- * by golden-section search; sl_tubes_sweep_refine polishes a float hit near a known t by
+ * sl_tubes_sweep_intersect first rejects rays that cannot meet the sweep in [l_min, l_max)
+ * (the control triangle grown by the largest radius, and the depth range), then finds the
+ * parameter intervals where the ray meets the spheres exactly (the roots of the quartic
+ * r^2 - |q|^2 + (d.q)^2 about the ray's point level with the middle control, isolated between
+ * the roots of its derivatives), samples l at 33 points of each and polishes every sampled
+ * minimum by golden-section search finished by Newton; sl_tubes_sweep_refine polishes a float hit near a known t by
  * Newton steps on l'(t). sl_tubes_sweep_regular says whether the sweep has the smooth envelope that
  * Embree's round curves assume. Pure functions, any thread.
  */
