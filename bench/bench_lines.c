@@ -42,7 +42,8 @@ static const row rows[] = {
     {"tubes", "tubes backend=gl, pre-pass on", "occlusion_prepass", "on", "backend", "gl"},
     {"tubes", "tubes backend=gl, one pass (paper)", "occlusion_prepass", "off", "backend", "gl"},
     {"tubes_mesh", "tubes_mesh (12 sides)", NULL, NULL, NULL, NULL},
-    {"voxel_lines", "voxel_lines opaque", NULL, NULL, NULL, NULL},
+    {"voxel_lines", "voxel_lines opaque (default: backend auto)", NULL, NULL, NULL, NULL},
+    {"voxel_lines", "voxel_lines opaque backend=gl", "backend", "gl", NULL, NULL},
 };
 #define ROW_COUNT ((int)(sizeof rows / sizeof rows[0]))
 

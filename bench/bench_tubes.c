@@ -266,6 +266,8 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
     sl_params_init(&params, tubes->params, tubes->param_count);
     double radius = sl_dataset_radius(ds) / 60.0; /* tubes several pixels wide, so most pixels are not at a rim */
     sl_params_set_numbers(&params, "radius", &radius, 1, err);
+    /* root_method and iterations are the GL path's; the Embree backend gets its own row */
+    sl_params_set_choice(&params, "backend", "gl", err);
     sl_view view;
     size_t np = (size_t)w * h;
     float *ref = calloc(np, sizeof *ref), *rad = calloc(np, sizeof *rad), *gpu_d = calloc(np, sizeof *gpu_d);
@@ -336,6 +338,27 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
             fflush(stdout);
         }
     }
+    if (sl_params_set_choice(&params, "backend", "embree", err) == SL_OK &&
+        sl_pipeline_set_technique(p, tubes, &params, err) == SL_OK) {
+        double ms[3];
+        sl_frame_stats stats;
+        for (int f = 0; f < 3; f++) {
+            if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
+                goto done;
+            ms[f] = stats.wall_ms;
+        }
+        sl_pipeline_read_distance(p, &view, gpu_d);
+        sl_bench_timing big;
+        if ((st = sl_bench_time_frames(p, tubes, &params, &one, SL_QUALITY_STILL, fixed_camera, &view.camera, &big,
+                                       err)) != SL_OK)
+            goto done;
+        error_stats e = compare(gpu_d, ref, rad, w, h);
+        printf("| backend=embree (exact double where bent) | - | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f | %.1f |\n",
+               e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3), big.median_ms);
+    } else {
+        printf("| backend=embree | - | not built: %s | | | | | | |\n", err->message);
+    }
+    sl_params_set_choice(&params, "backend", "gl", err);
     printf("\nFewest iterations (of those tried) for max error away from silhouettes <= E and mean error <= E/10 "
            "(x radius); in brackets, how many times fewer than %s (-1: not reached):\n\n| E |", nm > 0 ? methods[0] : "");
     for (int m = 0; m < nm && m < 8; m++)

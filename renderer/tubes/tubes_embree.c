@@ -661,6 +661,10 @@ static void resolve_pixel(frame_job *job, int x, int y, const double d[3], unsig
             best_l = l;
             best_t = t;
         }
+        /* an exact candidate is its true entry and the nearest reported one; no primitive's
+         * reported entry lies behind its true one, so none is nearer: nothing to trace on */
+        if (okc && geom == GEOM_EXACT && l <= exact_l)
+            break;
         /* the next candidate beyond this one, nearer than the best entry */
         atomic_fetch_add_explicit(&job->retraced, 1, memory_order_relaxed);
         struct RTCRayHit rh;

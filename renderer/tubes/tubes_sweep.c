@@ -357,11 +357,13 @@ int sl_tubes_sweep_intersect(const sl_tubes_sweep *s, const double o[3], const d
         int ok[M + 1];
         /* branch-free, so that the compiler can evaluate several samples at once */
         for (int i = 0; i <= M; i++) {
-            double ts = ta + (tb - ta) * i / M, g = poly_eval(D, 4, ts);
-            ok[i] = g >= 0.0;
-            double e = poly_eval(A, 2, ts) - sqrt(g >= 0.0 ? g : 0.0);
+            double ts = ta + (tb - ta) * i / M;
+            double g = (((D[4] * ts + D[3]) * ts + D[2]) * ts + D[1]) * ts + D[0];
+            double e = (A[2] * ts + A[1]) * ts + A[0] - sqrt(g >= 0.0 ? g : 0.0);
             f[i] = g >= 0.0 ? e : INFINITY;
         }
+        for (int i = 0; i <= M; i++)
+            ok[i] = f[i] < INFINITY;
         for (int i = 0; i <= M; i++) {
             double ti = ta + (tb - ta) * i / M;
             if (!ok[i])
