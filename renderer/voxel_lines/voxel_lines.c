@@ -633,6 +633,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
             (st = sl_voxel_cast_render(&s->cpu, &cp, view, &s->host, &s->cast, err)) != SL_OK)
             return st;
         counters.cpu_frames++;
+        stats->threads = s->cast.threads;
         return sl_host_frame_draw(&s->host, err);
     }
 

@@ -110,6 +110,14 @@ foreach(case "auto|cpu" "gl|gl" "cpu|cpu")
     "-DOUT2=\"backend\":[ \t]*\"${expect}\""
     ${SL_STEPS})
 endforeach()
+# The cpu backend traces on the workers asked for (SIGHTLINE_THREADS=2) and says so.
+voxel_render_test(voxel_lines.threads_cpu
+  ${CMAKE_COMMAND}
+  "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${VOXEL_DIR}/opaque.json|--set|params.backend=cpu|--out|${SL_RENDER_OUT}/voxel_lines/threads_cpu.png|--stats|${SL_RENDER_OUT}/voxel_lines/threads_cpu.json"
+  "-DSTEP2=${CMAKE_COMMAND}|-E|cat|${SL_RENDER_OUT}/voxel_lines/threads_cpu.json"
+  "-DOUT2=\"threads\":[ \t]*2,"
+  ${SL_STEPS})
+set_tests_properties(render.voxel_lines.threads_cpu PROPERTIES ENVIRONMENT "${SL_TEST_ENV};SIGHTLINE_THREADS=2")
 # The limits catch a uniform error: +3 on every drawn pixel of the lines_oit
 # golden (28 % of the frame drawn) is a covered mean of 3, over 1; over the
 # whole frame it was 0.83 with no pixel over 8, and passed (step 2).
