@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sl_camera_json.h"
 #include "sl_params_json.h"
-#include "sl_scene.h"
 
 void sl_scene_path_destroy(sl_scene_path *p)
 {

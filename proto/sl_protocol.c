@@ -4,7 +4,7 @@
  * "bad_field" naming the key, so a typo never silently does nothing. Only
  * syntax and ranges are checked here (see sl_protocol.h for what is not).
  * Any thread; no allocation beyond the cJSON tree the message owns.
- * Cameras are checked with the scene parser's own rules (sl_scene.h) plus
+ * Cameras are checked with the scene parser's own rules (sl_camera_json.h) plus
  * the protocol's range limits, never a second copy of those rules.
  */
 #include "sl_protocol.h"
@@ -14,8 +14,8 @@
 #include <string.h>
 
 #include "core/sl_camera.h"
+#include "sl_camera_json.h"
 #include "sl_params_json.h"
-#include "sl_scene.h"
 
 typedef struct msg_spec {
     const char *name;

@@ -46,16 +46,6 @@ sl_status sl_scene_apply_override(cJSON *root, const char *assignment, sl_err *e
  * relative file paths are looked up. */
 sl_status sl_scene_open_dataset(const sl_scene *scene, const char *data_dir, sl_dataset **out, sl_err *err);
 
-/* Parses a camera object (either form) — shared with the wire protocol.
- * Keys it leaves out take sl_orbit_default's values (up: +y). On failure
- * (SL_ERR_INVALID naming the field) *out is unchanged. */
-sl_status sl_camera_json_parse(const cJSON *obj, sl_camera_spec *out, sl_err *err);
-/* The complete camera object of spec (every key, defaults written out),
- * which sl_camera_json_parse reads back to the same numbers to within
- * cJSON's printing (15 digits when that is within DBL_EPSILON); NULL when
- * out of memory. Free with cJSON_Delete. */
-cJSON *sl_camera_to_json(const sl_camera_spec *spec);
-
 /* The view of frame `frame` (orbit_frames advance the azimuth by
  * 360/orbit_frames per frame; a path gives the camera at t = frame / fps)
  * for a dataset's bounds. */

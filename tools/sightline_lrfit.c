@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "data/sl_dataset_open.h"
-#include "lrspline/sl_lr_fit.h"
+#include "data/sl_lr_fit_dataset.h"
 #include "lrspline/sl_lr_write.h"
 
 static void usage(void)

@@ -3,10 +3,13 @@
  * basis function's local knot vectors, restricted to the polynomial piece of
  * the element the point lies in (see sl_lr.h). This is the reference the GPU
  * path and the Bézier conversion are tested against; keep it independent of
- * both. Any thread; no GL. */
+ * both. The element search lives here too: the linear reference and, where
+ * the model carries an index (lr_index.c), its look-up. Any thread; no GL. */
 #include "sl_lr.h"
 
 #include <math.h>
+
+#include "sl_lr_lookup.h"
 
 void sl_lr_bspline_piece(const double *t, int order, double a, double b, double x,
                          double *value, double *derivative)
@@ -84,4 +87,31 @@ sl_status sl_lr_eval(const sl_lr_volume *lr, const double p[3], long element,
         }
     }
     return SL_OK;
+}
+
+static int inside_rule(const sl_lr_volume *lr, const sl_lr_element *e, const double p[3])
+{
+    for (int d = 0; d < 3; d++) {
+        if (p[d] < e->lo[d])
+            return 0;
+        if (p[d] >= e->hi[d] && !(p[d] == e->hi[d] && e->hi[d] == lr->domain_hi[d]))
+            return 0;
+    }
+    return 1;
+}
+
+long sl_lr_find_element_linear(const sl_lr_volume *lr, const double p[3])
+{
+    for (int d = 0; d < 3; d++)
+        if (!isfinite(p[d]) || p[d] < lr->domain_lo[d] || p[d] > lr->domain_hi[d])
+            return -1;
+    for (size_t i = 0; i < lr->element_count; i++)
+        if (inside_rule(lr, &lr->elements[i], p))
+            return (long)i;
+    return -1;
+}
+
+long sl_lr_find_element(const sl_lr_volume *lr, const double p[3])
+{
+    return lr->index ? sl_lr_lookup_find(lr->index, p) : sl_lr_find_element_linear(lr, p);
 }

@@ -32,13 +32,7 @@ void sl_lr_fit_defaults(sl_lr_fit_params *p)
     p->cg_tol = 1e-8;
 }
 
-typedef struct samples {
-    int n[3];
-    double *x[3];  /* sample coordinates per axis, ascending */
-    double *y;     /* n0*n1*n2*dim values, x fastest */
-    int dim;
-    double lo[3], hi[3];
-} samples;
+typedef sl_lr_fit_samples samples;
 
 typedef struct design {
     size_t rows;
@@ -444,14 +438,8 @@ static double now_seconds(void)
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-static sl_status check_params(const sl_dataset *ds, const sl_lr_fit_params *p, sl_err *err)
+sl_status sl_lr_fit_check_params(const sl_lr_fit_params *p, sl_err *err)
 {
-    if (!ds || (ds->kind != SL_DATASET_VOLUME && ds->kind != SL_DATASET_VECTORS))
-        return sl_err_set(err, SL_ERR_INVALID, "LR fitting needs a regular scalar volume or vector field");
-    for (int d = 0; d < 3; d++)
-        if (ds->volume.dims[d] < 2)
-            return sl_err_set(err, SL_ERR_INVALID, "the volume has %d voxels along axis %d: need at least 2",
-                              ds->volume.dims[d], d);
     if (p->degree < 1 || p->degree > SL_LR_MAX_ORDER - 1)
         return sl_err_set(err, SL_ERR_INVALID, "degree %d is outside 1..%d", p->degree, SL_LR_MAX_ORDER - 1);
     if (!(p->tol >= 0.0) || !isfinite(p->tol))
@@ -473,75 +461,22 @@ static sl_status check_params(const sl_dataset *ds, const sl_lr_fit_params *p, s
     return SL_OK;
 }
 
-static sl_status make_samples(const sl_dataset *ds, int stride, samples *s, sl_err *err)
-{
-    memset(s, 0, sizeof *s);
-    const sl_volume *v = &ds->volume;
-    s->dim = v->components == 3 ? 3 : 1;
-    double origin[3] = {ds->origin.x, ds->origin.y, ds->origin.z};
-    size_t total = 1;
-    int *idx[3] = {NULL, NULL, NULL};
-    for (int d = 0; d < 3; d++) {
-        int n = (v->dims[d] - 1 + stride - 1) / stride + 1; /* 0, s, 2s, .., and the last voxel */
-        s->n[d] = n;
-        s->x[d] = malloc((size_t)n * sizeof(double));
-        idx[d] = malloc((size_t)n * sizeof(int));
-        if (!s->x[d] || !idx[d])
-            goto oom;
-        for (int m = 0; m < n; m++) {
-            int i = m * stride < v->dims[d] - 1 ? m * stride : v->dims[d] - 1;
-            idx[d][m] = i;
-            s->x[d][m] = origin[d] + i * v->spacing[d];
-        }
-        s->lo[d] = s->x[d][0];
-        s->hi[d] = s->x[d][n - 1];
-        total *= (size_t)n;
-    }
-    if (total > (size_t)UINT32_MAX / 4) {
-        for (int d = 0; d < 3; d++)
-            free(idx[d]);
-        return sl_err_set(err, SL_ERR_LIMIT, "%zu samples are too many: use a larger stride", total);
-    }
-    s->y = malloc(total * (size_t)s->dim * sizeof *s->y);
-    if (!s->y)
-        goto oom;
-    size_t k = 0;
-    for (int z = 0; z < s->n[2]; z++)
-        for (int y = 0; y < s->n[1]; y++)
-            for (int x = 0; x < s->n[0]; x++)
-                for (int c = 0; c < s->dim; c++)
-                    s->y[k++] = sl_volume_value(v, (size_t)idx[0][x], (size_t)idx[1][y], (size_t)idx[2][z], c);
-    for (int d = 0; d < 3; d++)
-        free(idx[d]);
-    return SL_OK;
-oom:
-    for (int d = 0; d < 3; d++) {
-        free(idx[d]);
-        free(s->x[d]);
-        s->x[d] = NULL;
-    }
-    return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the fit samples");
-}
-
-static void free_samples(samples *s)
-{
-    for (int d = 0; d < 3; d++)
-        free(s->x[d]);
-    free(s->y);
-}
-
-sl_status sl_lr_fit(const sl_dataset *ds, const sl_lr_fit_params *p, sl_lr_volume *out,
-                    sl_lr_fit_stats *stats, sl_err *err)
+sl_status sl_lr_fit_grid(const sl_lr_fit_samples *grid, const sl_lr_fit_params *p, sl_lr_volume *out,
+                         sl_lr_fit_stats *stats, sl_err *err)
 {
     memset(out, 0, sizeof *out);
     memset(stats, 0, sizeof *stats);
-    sl_status st = check_params(ds, p, err);
+    sl_status st = sl_lr_fit_check_params(p, err);
     if (st != SL_OK)
         return st;
+    for (int d = 0; d < 3; d++)
+        if (grid->n[d] < 2 || !(grid->hi[d] > grid->lo[d]))
+            return sl_err_set(err, SL_ERR_INVALID, "the samples have %d points along axis %d: need at least 2",
+                              grid->n[d], d);
+    if (grid->dim != 1 && grid->dim != 3)
+        return sl_err_set(err, SL_ERR_INVALID, "%d components: the fit takes 1 or 3", grid->dim);
     double t0 = now_seconds();
-    samples s;
-    if ((st = make_samples(ds, p->stride, &s, err)) != SL_OK)
-        return st;
+    const samples s = *grid;
     /* The initial tensor mesh. */
     double longest = 0.0, h0[3], min_span[3];
     for (int d = 0; d < 3; d++)
@@ -578,12 +513,10 @@ knots_done:
     for (int d = 0; d < 3; d++)
         free(knots[d]);
     if (st != SL_OK) {
-        free_samples(&s);
         return st;
     }
     if (out->basis_count > p->max_basis) {
         sl_lr_free(out);
-        free_samples(&s);
         return sl_err_set(err, SL_ERR_INVALID, "the initial mesh already has %zu basis functions, above the"
                           " cap of %zu", out->basis_count, p->max_basis);
     }
@@ -672,7 +605,6 @@ knots_done:
     free(cand);
     free(ids);
     sl_lr_free(&prev);
-    free_samples(&s);
     /* The value range after the last coefficients (and the last check). */
     if (st == SL_OK)
         st = sl_lr_finish(out, err);

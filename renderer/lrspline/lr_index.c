@@ -1,5 +1,5 @@
-/* lr_index.c — the CPU element look-up a model carries (sl_lr_index,
- * sl_lr_find_element in sl_lr.h): the `auto` structure of sl_lr_lookup.h,
+/* lr_index.c — the CPU element look-up a model carries (sl_lr_index in
+ * sl_lr.h; lr_eval.c's sl_lr_find_element asks it): the `auto` structure of sl_lr_lookup.h,
  * built once per finished model and read-only afterwards, so any number of
  * threads may query it; sl_lr_index_match hands it to whoever would build
  * the same structure again (the GPU blocks of sl_lr_bezier.h). */
@@ -30,11 +30,6 @@ void sl_lr_drop_index(sl_lr_volume *lr)
         free(lr->index);
         lr->index = NULL;
     }
-}
-
-long sl_lr_find_element(const sl_lr_volume *lr, const double p[3])
-{
-    return lr->index ? sl_lr_lookup_find(lr->index, p) : sl_lr_find_element_linear(lr, p);
 }
 
 const sl_lr_lookup *sl_lr_index_match(const sl_lr_volume *lr, sl_lr_lookup_kind kind, int forest_axis)

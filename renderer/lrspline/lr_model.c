@@ -1,6 +1,6 @@
 /* lr_model.c — allocation, validation and derived fields of an LR-spline
- * volume model, the mesh-rectangle rule shared with the loader, and the
- * linear element search (see sl_lr.h). Mesh rectangles are checked against
+ * volume model and the mesh-rectangle rule shared with the loader (see
+ * sl_lr.h); the element search is lr_eval.c's. Mesh rectangles are checked against
  * the domain box the elements span, so after the elements.
  * Any thread; no GL. */
 #include "sl_lr.h"
@@ -248,28 +248,6 @@ sl_status sl_lr_finish(sl_lr_volume *lr, sl_err *err)
         }
     }
     return SL_OK;
-}
-
-static int inside_rule(const sl_lr_volume *lr, const sl_lr_element *e, const double p[3])
-{
-    for (int d = 0; d < 3; d++) {
-        if (p[d] < e->lo[d])
-            return 0;
-        if (p[d] >= e->hi[d] && !(p[d] == e->hi[d] && e->hi[d] == lr->domain_hi[d]))
-            return 0;
-    }
-    return 1;
-}
-
-long sl_lr_find_element_linear(const sl_lr_volume *lr, const double p[3])
-{
-    for (int d = 0; d < 3; d++)
-        if (!isfinite(p[d]) || p[d] < lr->domain_lo[d] || p[d] > lr->domain_hi[d])
-            return -1;
-    for (size_t i = 0; i < lr->element_count; i++)
-        if (inside_rule(lr, &lr->elements[i], p))
-            return (long)i;
-    return -1;
 }
 
 double sl_lr_level_ratio(const sl_lr_volume *lr)

@@ -1,5 +1,6 @@
-/* sl_lr_fit.h — fits an adaptive LR-spline volume to a regular scalar
- * volume or vector field (issue 15; the tool is sightline-lrfit).
+/* sl_lr_fit.h — fits an adaptive LR-spline volume to samples of a regular scalar
+ * volume or vector field (issue 15; the tool is sightline-lrfit; datasets come in
+ * through data/sl_lr_fit_dataset.h).
  *
  * Method: the parameter domain is the world box of the voxel centres. Start
  * from a coarse tensor-product spline of the given degree (cells_longest
@@ -33,7 +34,6 @@
 
 #include <stdio.h>
 
-#include "../data/sl_dataset.h"
 #include "sl_lr.h"
 
 typedef enum {
@@ -70,17 +70,22 @@ typedef struct sl_lr_fit_stats {
     double seconds;
 } sl_lr_fit_stats;
 
-/* Fits ds (SL_DATASET_VOLUME or SL_DATASET_VECTORS, at least 2 voxels per
- * axis) into out (allocated here; sl_lr_free frees). SL_ERR_INVALID for bad
- * parameters or another kind of dataset. */
-sl_status sl_lr_fit(const sl_dataset *ds, const sl_lr_fit_params *p, sl_lr_volume *out,
-                    sl_lr_fit_stats *stats, sl_err *err);
+/* What a fit sees: values on a rectilinear grid of sample points. Datasets become one through
+ * data/sl_lr_fit_dataset.h (sl_lr_fit), which keeps this folder from knowing datasets. */
+typedef struct sl_lr_fit_samples {
+    int n[3];          /* points per axis, >= 2 */
+    double *x[3];      /* their coordinates per axis, ascending */
+    double *y;         /* n0*n1*n2*dim values, x fastest, the components of a point together */
+    int dim;           /* 1 (scalar) or 3 (vector) */
+    double lo[3], hi[3]; /* x[d][0] and x[d][n[d] - 1] */
+} sl_lr_fit_samples;
 
-/* A regular vector field sampled from an analytic formula, for fitting
- * tests and samples: "abc" (Arnold-Beltrami-Childress, A = sqrt 3,
- * B = sqrt 2, C = 1, on [0, 2 pi]^3) or "tornado" (Crawfis' tornado, the
- * formula of the tornado generator, phase 0, on [0, 1]^3), n^3 voxels
- * (2..512). */
-sl_status sl_lr_sample_field(const char *name, int n, sl_dataset **out, sl_err *err);
+/* SL_ERR_INVALID naming the first parameter out of its range. */
+sl_status sl_lr_fit_check_params(const sl_lr_fit_params *p, sl_err *err);
+
+/* Fits the samples (p->stride is the caller's: the samples are taken) into out (allocated
+ * here; sl_lr_free frees). SL_ERR_INVALID for bad parameters or samples. */
+sl_status sl_lr_fit_grid(const sl_lr_fit_samples *samples, const sl_lr_fit_params *p, sl_lr_volume *out,
+                         sl_lr_fit_stats *stats, sl_err *err);
 
 #endif

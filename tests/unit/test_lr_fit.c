@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "lrspline/sl_lr.h"
-#include "lrspline/sl_lr_fit.h"
+#include "data/sl_lr_fit_dataset.h"
 #include "sl_test.h"
 
 static double poly(double x, double y, double z)

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "data/sl_dataset.h"
+#include "sl_camera_json.h"
 #include "sl_params_json.h"
 #include "sl_scene.h"
 #include "sl_test.h"
