@@ -485,6 +485,11 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
                     }
                     if (outside(c, dims))
                         continue;
+                    /* an empty voxel adds nothing: skip it before its box test */
+                    size_t v = (size_t)c[0] + (size_t)dims[0] * ((size_t)c[1] + (size_t)dims[1] * c[2]);
+                    uint32_t count = m->count[v];
+                    if (!count)
+                        continue;
                     float bn = -1e30f, bf = 1e30f;
                     for (int k = 0; k < 3; k++) {
                         float b0 = ((float)c[k] - reach - o[k]) * inv_b[k];
@@ -494,8 +499,7 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
                     }
                     if (bn > min_f(bf, s_exit))
                         continue;
-                    size_t v = (size_t)c[0] + (size_t)dims[0] * ((size_t)c[1] + (size_t)dims[1] * c[2]);
-                    uint32_t count = m->count[v], first = m->first[v];
+                    uint32_t first = m->first[v];
                     float corner[3] = {(float)c[0], (float)c[1], (float)c[2]};
                     for (uint32_t l = 0; l < count; l++) {
                         const float *ab = m->ab + 6 * (size_t)(first + l);
