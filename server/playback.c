@@ -137,7 +137,8 @@ sl_status sl_play_start(sl_server *srv, sl_session *s, const cJSON *path, int lo
     s->play_base = s->state.params;
     s->play_frame = -1;
     s->play_t0_ms = sl_clock_ms();
-    sl_ws_play_schedule(srv, 0);
+    if (srv->transport.schedule_play)
+        srv->transport.schedule_play(srv, 0);
     return SL_OK;
 }
 

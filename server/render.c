@@ -46,18 +46,7 @@
 #include "sl_params_json.h"
 #include "sl_scene_path.h"
 
-enum job_kind { JOB_NONE, JOB_FRAME, JOB_STILL, JOB_SNAPSHOT, JOB_RECORD };
-
-typedef struct render_ctx {
-    sl_server *srv;
-    sl_gpu *gpu;
-    sl_encoder *enc;
-    uint8_t *rgba;
-    size_t rgba_cap;
-    unsigned rr;          /* round-robin start */
-    sl_dataset_cache *datasets;
-    sl_prepared_cache prepared;
-} render_ctx;
+#include "render_internal.h"
 
 /* A finished load (loader thread): counted, and the render thread picks its sessions up. */
 static void on_load_done(void *arg, sl_status status, double load_ms)
@@ -374,7 +363,7 @@ static void report_error(sl_server *srv, sl_session *s, const sl_session_state *
  * technique's prepare when it is due, announced before it runs (`preparing`,
  * then `first_frame`). Returns 1 when ready; 0 when waiting for a load or
  * failed, with the failure reported and the round ended. */
-static int ready_scene(render_ctx *ctx, sl_session *s, const sl_session_state *st)
+int sl_render_ready_scene(render_ctx *ctx, sl_session *s, const sl_session_state *st)
 {
     sl_err err = {0};
     enum scene_status ss = ensure_scene(ctx, s, st, &err);
@@ -419,7 +408,7 @@ static int ready_scene(render_ctx *ctx, sl_session *s, const sl_session_state *s
 /* Renders the session's prepared scene (ready_scene first) at scale (1 =
  * the session's size) with interactive or still quality; *render_ms is the
  * render call's wall time (no prepare: ready_scene ran it). */
-static sl_status render_view(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
+sl_status sl_render_view(render_ctx *ctx, sl_session *s, const sl_session_state *st, int interactive,
                              double scale, int *w_out, int *h_out, double *render_ms, const char **backend,
                              sl_err *err)
 {
@@ -460,7 +449,7 @@ static sl_status render_view(render_ctx *ctx, sl_session *s, const sl_session_st
 
 /* --test-frame-delay-ms, --test-frame-fixed-ms: a render cost proportional
  * to the frame's pixels, and one that is not. */
-static void test_delay(const sl_server *srv, const sl_session_state *st, int w, int h)
+void sl_render_test_delay(const sl_server *srv, const sl_session_state *st, int w, int h)
 {
     double ms = srv->cfg.test_frame_delay_ms * ((double)w * h) / ((double)st->width * st->height) +
                 srv->cfg.test_frame_fixed_ms;
@@ -479,17 +468,17 @@ static void do_frame(render_ctx *ctx, sl_session *s, const sl_session_state *st,
     sl_frame_buf *f = NULL;
     sl_iscale_sync(&s->iscale, scene_key(st), st->stream.interactive_scale);
     double scale = interactive ? sl_iscale_choose(&s->iscale, &st->stream, &step) : 1.0;
-    if (!ready_scene(ctx, s, st))
+    if (!sl_render_ready_scene(ctx, s, st))
         return;
     double t0 = sl_clock_ms();
     const char *backend = NULL;
-    if (render_view(ctx, s, st, interactive, scale, &w, &h, &render_ms, &backend, &err) != SL_OK) {
+    if (sl_render_view(ctx, s, st, interactive, scale, &w, &h, &render_ms, &backend, &err) != SL_OK) {
         sl_progress_end(ctx->srv, s, 0, 0, 0);
         report_error(ctx->srv, s, st, &err);
         return;
     }
     sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 0);
-    test_delay(ctx->srv, st, w, h);
+    sl_render_test_delay(ctx->srv, st, w, h);
     render_ms = sl_clock_ms() - t0;
     int quality = interactive ? st->stream.interactive_quality : st->stream.still_quality;
     int sub420 = interactive ? st->stream.interactive_420 : st->stream.still_420;
@@ -549,13 +538,13 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
     double render_ms = 0, encode_ms = 0;
     sl_frame_buf *f = NULL;
     sl_server *srv = ctx->srv;
-    if (!ready_scene(ctx, s, st)) {
+    if (!sl_render_ready_scene(ctx, s, st)) {
         if (s->load)
             requeue_snapshots(srv, s, ids, n);
         return;
     }
     const char *backend = NULL;
-    if (render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &backend, &err) == SL_OK) {
+    if (sl_render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &backend, &err) == SL_OK) {
         sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 1);
         if (sl_encoder_png(ctx->rgba, w, h, &f, &encode_ms, &err) == SL_OK) {
             f->header.state_version = st->version;
@@ -579,123 +568,8 @@ static void do_snapshot(render_ctx *ctx, sl_session *s, const sl_session_state *
     pthread_mutex_unlock(&srv->lock);
 }
 
-/* Ends the session's recording job with `state` (and extra fields, consumed). */
-static void record_finish(sl_server *srv, sl_session *s, sl_record_job *j, const char *state, int ok, cJSON *extra)
-{
-    pthread_mutex_lock(&srv->lock);
-    j->finished = 1;
-    j->ok = ok;
-    sl_record_status_locked(s, j, state, extra);
-    pthread_mutex_unlock(&srv->lock);
-}
-
-static void record_fail(sl_server *srv, sl_session *s, sl_record_job *j, int frame, const sl_err *err)
-{
-    sl_video_abort(j->writer);
-    j->writer = NULL;
-    cJSON *x = cJSON_CreateObject();
-    char msg[600];
-    snprintf(msg, sizeof msg, "frame %d: %.560s", frame, err->message);
-    cJSON_AddStringToObject(x, "message", msg);
-    record_finish(srv, s, j, "failed", 0, x);
-}
-
-/* One frame of the session's recording job at full still quality (or its
- * cancel): the job's base state with the path's camera and parameters at
- * t = frame / fps, through the session's prepared scene (ready_scene
- * switches scenes when a keyed parameter needs another prepare: costly,
- * as scene.md says). The session's latest frame and state are untouched. */
-static void do_record(render_ctx *ctx, sl_session *s, sl_record_job *j, int cancel)
-{
-    sl_server *srv = ctx->srv;
-    if (cancel) {
-        sl_video_abort(j->writer);
-        j->writer = NULL;
-        record_finish(srv, s, j, "cancelled", 0, NULL);
-        return;
-    }
-    sl_err err = {0};
-    int f = j->next_frame;
-    double t = f / j->path->fps;
-    sl_session_state *st = malloc(sizeof *st);
-    if (!st) {
-        sl_err_set(&err, SL_ERR_NOMEM, "out of memory");
-        record_fail(srv, s, j, f, &err);
-        return;
-    }
-    *st = j->base;
-    const sl_technique *tech = sl_technique_find(st->technique);
-    cJSON *keyed = tech ? sl_scene_path_params(j->path, t, NULL, tech) : NULL;
-    sl_status rc = keyed ? sl_params_apply_json(&st->params, keyed, &err)
-                         : sl_err_set(&err, SL_ERR_NOMEM, "no parameters at t = %g", t);
-    cJSON_Delete(keyed);
-    if (rc == SL_OK && !ready_scene(ctx, s, st)) {
-        free(st); /* waiting for a load (tried again later) or failed (reported to the session) */
-        if (!s->load) {
-            cJSON *x = cJSON_CreateObject();
-            cJSON_AddStringToObject(x, "message", "the recording's scene could not be prepared (the session's "
-                                                  "render_failed error says why)");
-            record_finish(srv, s, j, "failed", 0, x);
-        }
-        return;
-    }
-    const sl_dataset *ds = rc == SL_OK ? s->prepared->dataset : NULL;
-    if (rc == SL_OK)
-        rc = sl_camera_path_at(j->path->keys, j->path->key_count, j->path->interpolation, t, ds->bounds_min,
-                               ds->bounds_max, &st->camera, &err);
-    if (rc == SL_OK && !j->writer) {
-        rc = sl_video_open(&(sl_video_desc){j->file, st->width, st->height, j->path->fps, j->crf}, &j->writer, &err);
-        j->t0_ms = sl_clock_ms();
-    }
-    int w = 0, h = 0;
-    double render_ms = 0;
-    const char *backend = NULL;
-    if (rc == SL_OK)
-        rc = render_view(ctx, s, st, 0, 1.0, &w, &h, &render_ms, &backend, &err);
-    if (rc == SL_OK) {
-        sl_pipeline_read_rgba(s->prepared->pipeline, ctx->rgba, 1);
-        test_delay(srv, st, w, h);
-        rc = sl_video_write_rgba(j->writer, ctx->rgba, &err);
-    }
-    free(st);
-    if (rc != SL_OK) {
-        record_fail(srv, s, j, f, &err);
-        return;
-    }
-    j->next_frame++;
-    double spent = (sl_clock_ms() - j->t0_ms) / 1000.0;
-    if (j->next_frame < j->frames) {
-        cJSON *x = cJSON_CreateObject();
-        cJSON_AddNumberToObject(x, "frame", j->next_frame);
-        cJSON_AddNumberToObject(x, "elapsed_s", spent);
-        cJSON_AddNumberToObject(x, "eta_s", spent / j->next_frame * (j->frames - j->next_frame));
-        pthread_mutex_lock(&srv->lock);
-        sl_record_status_locked(s, j, "running", x);
-        pthread_mutex_unlock(&srv->lock);
-        return;
-    }
-    sl_video_summary sum;
-    rc = sl_video_close(j->writer, &sum, &err);
-    j->writer = NULL;
-    if (rc != SL_OK) {
-        record_fail(srv, s, j, f, &err);
-        return;
-    }
-    cJSON *x = cJSON_CreateObject();
-    char url[64];
-    snprintf(url, sizeof url, "/recording/%s", j->key);
-    cJSON_AddNumberToObject(x, "frame", j->frames);
-    cJSON_AddNumberToObject(x, "elapsed_s", spent);
-    cJSON_AddStringToObject(x, "url", url);
-    cJSON_AddNumberToObject(x, "bytes", (double)sum.bytes);
-    cJSON_AddNumberToObject(x, "seconds", sum.seconds);
-    cJSON_AddStringToObject(x, "codec", sum.codec);
-    cJSON_AddNumberToObject(x, "crf", sum.crf);
-    record_finish(srv, s, j, "done", 1, x);
-}
-
 /* Lets go of what the session holds on this thread. */
-static void session_release(render_ctx *ctx, sl_session *s)
+void sl_render_session_release(render_ctx *ctx, sl_session *s)
 {
     sl_prepared_release(&ctx->prepared, s->prepared);
     s->prepared = NULL;
@@ -711,7 +585,7 @@ static void reap(render_ctx *ctx)
         sl_session *s = *pp;
         if (s->doomed && !s->rendering) {
             *pp = s->next;
-            session_release(ctx, s);
+            sl_render_session_release(ctx, s);
             sl_session_free(s);
             ctx->srv->prepared_scenes = ctx->prepared.count;
         } else {
@@ -781,7 +655,7 @@ static void *render_main(void *arg)
         if (kind == JOB_SNAPSHOT)
             do_snapshot(&ctx, s, copy, ids, nids);
         else if (kind == JOB_RECORD)
-            do_record(&ctx, s, record, record_cancel);
+            sl_render_record(&ctx, s, record, record_cancel);
         else
             do_frame(&ctx, s, copy, interactive);
         lws_cancel_service(srv->lws);
@@ -790,7 +664,7 @@ static void *render_main(void *arg)
     }
     /* Shutdown: GL objects die on this thread; sessions are freed by the service thread. */
     for (sl_session *s = srv->sessions; s; s = s->next)
-        session_release(&ctx, s);
+        sl_render_session_release(&ctx, s);
     reap(&ctx);
     pthread_mutex_unlock(&srv->lock);
     sl_dataset_cache_destroy(ctx.datasets);

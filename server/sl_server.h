@@ -1,10 +1,22 @@
 /* sl_server.h — the internal contract between sightline-server's parts.
  *
  *   main.c     arguments, the `catalog` subcommand, start and stop
- *   ws.c       lws context, WebSocket protocol, static files (service thread)
- *   session.c  sessions, clients, control, grace period, message handling
- *              (service thread)
- *   render.c   the render thread: owns sl_gpu, the encoder, the prepared scenes
+ *   ws.c       lws context, WebSocket protocol, static files (service thread);
+ *              hands the layers below it sl_transport_hooks (a play timer, the
+ *              end of a connection's wait for hello) so they never call it
+ *   client_write.c  the write loop: one message per writable callback (service thread)
+ *   client_queue.c  a client's reply ring and close request (service thread)
+ *   session.c  sessions, hello, joining, the message table and its scene/camera/set/control
+ *              handlers (service thread); session_internal.h is what its files share
+ *   session_state.c  the state object, patches to every client, control (service thread)
+ *   session_paths.c  the path and recording messages (service thread)
+ *   session_wake.c  what the render thread left: frames, snapshots, reverts,
+ *              checkpoints, dataset descriptions (service thread)
+ *   session_drain.c  grace sweep, draining, teardown (service thread)
+ *   random_hex.c  random hex for ids, tokens, keys (any thread)
+ *   render.c   the render thread: owns sl_gpu, the encoder, the prepared scenes;
+ *              render_record.c renders a recording job's frames, render_internal.h
+ *              is what the two share
  *   prepared_cache.c  sl_pipelines shared by sessions on one scene (render thread)
  *   progress.c the `progress` rounds of long work, posted to sessions (render thread)
  *   interactive_scale.c  the adaptive scale of interactive frames (render thread)
@@ -392,7 +404,17 @@ void sl_histogram_add(sl_histogram *h, double ms);
 
 /* ---- the server ---- */
 
-typedef struct sl_server {
+/* What the transport (ws.c) hands the layers below it when it starts (sl_ws_create), so that
+ * they reach up only through these and never call the transport's files. */
+typedef struct sl_server sl_server;
+typedef struct sl_transport_hooks {
+    void (*schedule_play)(sl_server *srv, double ms); /* run sl_play_tick in ms from now (replacing an
+                                                         earlier schedule) */
+    void (*hello_done)(sl_server *srv, sl_client *c); /* c no longer waits for hello (it said hello or
+                                                         closes); no-op when it was not pending */
+} sl_transport_hooks;
+
+struct sl_server {
     sl_server_config cfg;
     struct lws_context *lws;
     int port;                                /* listening port (after sl_ws_create) */
@@ -421,9 +443,10 @@ typedef struct sl_server {
     cJSON *techniques_json;                  /* [service] cached list with schemas */
     char record_dir[64];                     /* recording files, made at start and removed at exit ("" none) */
     uint32_t next_record_id;                 /* [service] */
-} sl_server;
+    sl_transport_hooks transport;            /* [service] set by sl_ws_create */
+};
 
-/* session.c (service thread unless noted) */
+/* session.c and its files (session_*.c, client_*.c, random_hex.c; service thread unless noted) */
 void sl_sessions_on_text(sl_server *srv, sl_client *c, const char *text, size_t len);
 void sl_sessions_on_close(sl_server *srv, sl_client *c);
 void sl_sessions_on_wake(sl_server *srv);     /* dispatch frames, snapshots, errors */
@@ -474,8 +497,6 @@ void sl_play_stop(sl_server *srv, sl_session *s, const char *reason);
 sl_status sl_play_seek(sl_server *srv, sl_session *s, const cJSON *path, double t, sl_err *err);
 /* Steps every playing session; returns ms until the next step is due, -1 when nothing plays. */
 double sl_play_tick(sl_server *srv);
-/* ws.c: runs sl_play_tick in ms from now (replacing an earlier schedule). */
-void sl_ws_play_schedule(sl_server *srv, double ms);
 
 /* dataset_cache.c (any thread; its own lock): datasets by source, loaded on
  * SL_DATASET_LOADERS loader threads, the last SL_DATASET_CACHE_SLOTS kept. */
@@ -585,7 +606,7 @@ void sl_agent_reply(sl_server *srv, char out[32]);
 sl_status sl_agent_start(sl_server *srv, sl_err *err);
 void sl_agent_stop(sl_server *srv);                 /* NULL agent is fine */
 
-/* session.c: draining (main.c / ws.c, service thread) */
+/* session_drain.c: draining (main.c / ws.c, service thread) */
 /* Starts draining: new sessions are refused with `draining`. */
 void sl_sessions_drain_begin(sl_server *srv);
 /* 1 once draining may end: no session has clients, or --grace seconds have
@@ -602,8 +623,6 @@ char *sl_http_metrics(sl_server *srv);
 
 /* ws.c */
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err);
-/* c no longer waits for hello (it said hello or closes); no-op when not pending. */
-void sl_ws_pending_leave(sl_server *srv, sl_client *c);
 /* ws_client_address.c: the client address of upgrade wsi (the peer, or behind a
  * --trusted-proxy the address it forwards), canonical text in out (size >=
  * SL_CLIENT_ADDRESS_MAX). count: 1 at the first look of an upgrade, which

@@ -120,7 +120,7 @@ static int pending_from(const sl_server *srv, const char *addr)
     return n;
 }
 
-void sl_ws_pending_leave(sl_server *srv, sl_client *c)
+static void pending_leave(sl_server *srv, sl_client *c)
 {
     if (!c->pending)
         return;
@@ -146,7 +146,7 @@ static void evict_oldest_pending(sl_server *srv)
     if (!oldest)
         return;
     lwsl_notice("evicted a pending WebSocket from %s (--max-pending %d)\n", oldest->addr, srv->cfg.max_pending);
-    sl_ws_pending_leave(srv, oldest);
+    pending_leave(srv, oldest);
     char reason[80];
     snprintf(reason, sizeof reason, "pending budget: %d connections without hello (--max-pending)",
              srv->cfg.max_pending);
@@ -231,7 +231,7 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
         if (pss->client) {
             sl_client *c = pss->client;
             int counted = c->hello_done;
-            sl_ws_pending_leave(srv, c);
+            pending_leave(srv, c);
             sl_sessions_on_close(srv, c);
             free(c);
             pss->client = NULL;
@@ -433,7 +433,7 @@ static void play_cb(lws_sorted_usec_list_t *sul)
         lws_sul_schedule(play_timer.srv->lws, 0, &play_timer.sul, play_cb, (lws_usec_t)(next_ms * 1000.0) + 1);
 }
 
-void sl_ws_play_schedule(sl_server *srv, double ms)
+static void schedule_play(sl_server *srv, double ms)
 {
     play_timer.srv = srv;
     lws_sul_schedule(srv->lws, 0, &play_timer.sul, play_cb, (lws_usec_t)(ms * 1000.0) + 1);
@@ -442,6 +442,7 @@ void sl_ws_play_schedule(sl_server *srv, double ms)
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
 {
     lws_set_log_level(LLL_ERR | LLL_WARN, NULL);
+    srv->transport = (sl_transport_hooks){.schedule_play = schedule_play, .hello_done = pending_leave};
     mount_root.origin = srv->cfg.web_dir;
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);
