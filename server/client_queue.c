@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <libwebsockets.h>
 
 #include "session_internal.h"
 
@@ -18,8 +17,8 @@ void sl_client_close(sl_client *c, int code, const char *reason, int after_repli
     c->close_code = code;
     c->close_after_replies = after_replies;
     snprintf(c->close_reason, sizeof c->close_reason, "%s", reason);
-    lws_set_timeout(c->wsi, PENDING_TIMEOUT_CLOSE_SEND, SL_CLOSE_GRACE_S);
-    lws_callback_on_writable(c->wsi);
+    if (c->transport && c->transport->closing)
+        c->transport->closing(c);
 }
 
 /* The next free slot of c's reply ring, or NULL when the reply budget is
@@ -31,20 +30,20 @@ static sl_reply *reply_slot(sl_client *c)
     if (c->reply_count >= SL_CLIENT_MAX_TEXT) {
         char reason[80];
         snprintf(reason, sizeof reason, "reply budget: %d replies not read", SL_CLIENT_MAX_TEXT);
-        sl_client_close(c, LWS_CLOSE_STATUS_POLICY_VIOLATION, reason, 0);
+        sl_client_close(c, SL_CLOSE_POLICY_VIOLATION, reason, 0);
         return NULL;
     }
     sl_reply *r = &c->replies[(c->reply_head + c->reply_count) % SL_CLIENT_MAX_TEXT];
     memset(r, 0, sizeof *r);
     c->reply_count++;
-    lws_callback_on_writable(c->wsi);
+    sl_client_wake(c);
     return r;
 }
 
 int sl_client_queue_text(sl_client *c, char *text)
 {
     if (!text) {
-        sl_client_close(c, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory", 0);
+        sl_client_close(c, SL_CLOSE_UNEXPECTED_CONDITION, "out of memory", 0);
         return -1;
     }
     sl_reply *r = reply_slot(c);
@@ -62,7 +61,7 @@ int sl_client_queue_error(sl_client *c, const char *code, const char *message, c
         field = "";
     char *text = strdup(message ? message : "");
     if (!text) {
-        sl_client_close(c, LWS_CLOSE_STATUS_UNEXPECTED_CONDITION, "out of memory", 0);
+        sl_client_close(c, SL_CLOSE_UNEXPECTED_CONDITION, "out of memory", 0);
         return -1;
     }
     for (int i = 0; i < c->reply_count; i++) {
@@ -97,5 +96,11 @@ void sl_client_send_error(sl_server *srv, sl_client *c, const char *code, const 
 void sl_client_refuse(sl_server *srv, sl_client *c, const char *code, const char *message, const char *field)
 {
     sl_client_send_error(srv, c, code, message, field);
-    sl_client_close(c, LWS_CLOSE_STATUS_POLICY_VIOLATION, code, 1);
+    sl_client_close(c, SL_CLOSE_POLICY_VIOLATION, code, 1);
+}
+
+void sl_client_wake(sl_client *c)
+{
+    if (c->transport && c->transport->want_write)
+        c->transport->want_write(c);
 }

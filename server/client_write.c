@@ -37,16 +37,16 @@ static int write_text_now(sl_client *c, char *text)
     uint8_t *buf = lws_text_buffer(text, &len);
     if (!buf)
         return -1;
-    int rc = write_buf(c->wsi, buf + LWS_PRE, len, LWS_WRITE_TEXT);
+    int rc = write_buf((struct lws *)c->link, buf + LWS_PRE, len, LWS_WRITE_TEXT);
     free(buf);
-    lws_callback_on_writable(c->wsi);
+    lws_callback_on_writable((struct lws *)c->link);
     return rc;
 }
 
 int sl_client_write_next(sl_server *srv, sl_client *c)
 {
     if (c->close_code && (!c->close_after_replies || c->reply_count == 0)) {
-        lws_close_reason(c->wsi, (enum lws_close_status)c->close_code, (unsigned char *)c->close_reason,
+        lws_close_reason((struct lws *)c->link, (enum lws_close_status)c->close_code, (unsigned char *)c->close_reason,
                          strlen(c->close_reason));
         return -1;
     }
@@ -125,9 +125,9 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     if (c->snapshot) {
         sl_frame_buf *f = c->snapshot;
         c->snapshot = NULL;
-        int rc = write_buf(c->wsi, f->data, f->size, LWS_WRITE_BINARY);
+        int rc = write_buf((struct lws *)c->link, f->data, f->size, LWS_WRITE_BINARY);
         sl_frame_buf_unref(f);
-        lws_callback_on_writable(c->wsi);
+        lws_callback_on_writable((struct lws *)c->link);
         return rc;
     }
     sl_frame_buf *f = NULL;
@@ -145,7 +145,7 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
         return 0;
     c->sent_frame_id = f->header.frame_id;
     c->inflight[c->inflight_count++] = f->header.frame_id;
-    int rc = write_buf(c->wsi, f->data, f->size, LWS_WRITE_BINARY);
+    int rc = write_buf((struct lws *)c->link, f->data, f->size, LWS_WRITE_BINARY);
     sl_frame_buf_unref(f);
     return rc;
 }

@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <libwebsockets.h>
 
 #include "core/sl_camera_path.h"
 #include "core/sl_technique.h"
@@ -43,7 +42,7 @@ static void post_text(sl_session *s, char *text)
     s->play_text = text;
     s->play_seq++;
     for (sl_client *c = s->clients; c; c = c->next)
-        lws_callback_on_writable(c->wsi);
+        sl_client_wake(c);
 }
 
 /* The dataset bounds the session knows ([service] s->bounds); 0 when not loaded yet. */

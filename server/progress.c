@@ -16,7 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <libwebsockets.h>
 
 static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double render_ms, uint32_t frame, int ok)
 {
@@ -35,7 +34,8 @@ static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double 
     s->progress_closed = stage == SL_PROGRESS_DONE;
     pthread_mutex_unlock(&srv->lock);
     free(old);
-    lws_cancel_service(srv->lws);
+    if (srv->transport.wake_service)
+        srv->transport.wake_service(srv);
 }
 
 void sl_progress_begin(sl_server *srv, sl_session *s, const sl_session_state *st)

@@ -13,7 +13,7 @@
  * load, copy its desired state, unlock, prepare if needed (announced as
  * `progress`) + render + read back + encode, lock, publish the frame as the
  * session's one latest frame (dropping the older one), unlock and wake the
- * service thread with lws_cancel_service. State that changed meanwhile is
+ * service thread through srv->transport.wake_service. State that changed meanwhile is
  * simply rendered next time: the newest state wins, nothing is queued.
  * Interactive frames (camera phase start/move/end younger than
  * still_delay_ms) render at the scale interactive_scale.c picks from the
@@ -35,7 +35,6 @@
 #include <string.h>
 #include <time.h>
 
-#include <libwebsockets.h>
 
 #include "core/sl_camera.h"
 #include "core/sl_clock.h"
@@ -658,7 +657,8 @@ static void *render_main(void *arg)
             sl_render_record(&ctx, s, record, record_cancel);
         else
             do_frame(&ctx, s, copy, interactive);
-        lws_cancel_service(srv->lws);
+        if (srv->transport.wake_service)
+            srv->transport.wake_service(srv);
         pthread_mutex_lock(&srv->lock);
         s->rendering = 0;
     }

@@ -28,7 +28,6 @@
 #include <string.h>
 #include <time.h>
 
-#include <libwebsockets.h>
 
 #include "core/sl_technique.h"
 #include "session_internal.h"
@@ -266,8 +265,6 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     c->record_seq = s->record && (!s->record->finished || s->record->ok) ? s->record_seq - 1 : s->record_seq;
     pthread_mutex_unlock(&srv->lock);
     c->play_seq = s->play ? s->play_seq - 1 : s->play_seq; /* a path playing is news; a stopped one is not */
-    lws_set_timeout(c->wsi, NO_PENDING_TIMEOUT, 0);
-    lws_set_timer_usecs(c->wsi, LWS_SET_TIMER_USEC_CANCEL); /* the hello timeout (ws.c) */
     sl_msg_welcome w = {.session = s->id, .token = s->token, .node = srv->cfg.node_id, .client = c->id,
                         .is_controller = s->controller == c->id, .state = sl_session_state_json(s),
                         .techniques = cJSON_Duplicate(srv->techniques_json, 1),
@@ -275,7 +272,7 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
                         .grace_s = srv->cfg.grace_s};
     sl_client_queue_text(c, sl_msg_welcome_text(&w));
     /* A late joiner gets the latest frame at once: write_next sends it. */
-    lws_callback_on_writable(c->wsi);
+    sl_client_wake(c);
     (void)srv;
 }
 
@@ -534,7 +531,7 @@ static void on_control(sl_server *srv, sl_client *c, const sl_msg *m)
         c->wants_control = 1;
         sl_client *ctl = sl_session_find_client(s, s->controller);
         if (ctl)
-            lws_callback_on_writable(ctl->wsi);
+            sl_client_wake(ctl);
         return;
     }
     case SL_CONTROL_GRANT:
@@ -646,7 +643,7 @@ static void on_ack(sl_server *srv, sl_client *c, const sl_msg *m)
         if (c->inflight[i] > m->frame_id)
             c->inflight[keep++] = c->inflight[i];
     c->inflight_count = keep;
-    lws_callback_on_writable(c->wsi);
+    sl_client_wake(c);
 }
 
 static void on_snapshot(sl_server *srv, sl_client *c, const sl_msg *m)

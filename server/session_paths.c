@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <libwebsockets.h>
 
 #include "session_internal.h"
 #include "core/sl_technique.h"
@@ -38,7 +37,7 @@ void sl_on_record(sl_server *srv, sl_client *c, const sl_msg *m)
     pthread_mutex_unlock(&srv->lock);
     sl_record_free(old);
     for (sl_client *o = s->clients; o; o = o->next)
-        lws_callback_on_writable(o->wsi);
+        sl_client_wake(o);
 }
 
 /* record_cancel: stops the running job (its partial file is removed). */

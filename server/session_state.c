@@ -6,7 +6,6 @@
 
 #include <string.h>
 
-#include <libwebsockets.h>
 
 #include "session_internal.h"
 #include "sl_camera_json.h"
@@ -39,7 +38,7 @@ void sl_session_broadcast_patch(sl_session *s, cJSON *patch)
                 cJSON_AddItemToObject(c->patch, it->string, dup);
         }
         c->patch_version = s->state.version;
-        lws_callback_on_writable(c->wsi);
+        sl_client_wake(c);
     }
     cJSON_Delete(patch);
 }

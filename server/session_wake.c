@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <libwebsockets.h>
 
 #include "session_internal.h"
 
@@ -60,7 +59,7 @@ void sl_sessions_on_wake(sl_server *srv)
         if (s->latest && s->latest->header.frame_id != s->dispatched_frame) {
             s->dispatched_frame = s->latest->header.frame_id;
             for (sl_client *c = s->clients; c; c = c->next)
-                lws_callback_on_writable(c->wsi);
+                sl_client_wake(c);
         }
         if (s->snap_ready) {
             for (int i = 0; i < s->snap_ready_count; i++) {
@@ -68,7 +67,7 @@ void sl_sessions_on_wake(sl_server *srv)
                 if (c && !c->snapshot) {
                     sl_frame_buf_ref(s->snap_ready);
                     c->snapshot = s->snap_ready;
-                    lws_callback_on_writable(c->wsi);
+                    sl_client_wake(c);
                 }
             }
             sl_frame_buf_unref(s->snap_ready);
@@ -79,7 +78,7 @@ void sl_sessions_on_wake(sl_server *srv)
          * a client that is behind gets the latest error once, not a backlog). */
         for (sl_client *c = s->clients; c; c = c->next)
             if (c->error_seq != s->error_seq || c->progress_seq != s->progress_seq || c->record_seq != s->record_seq)
-                lws_callback_on_writable(c->wsi);
+                sl_client_wake(c);
     }
     pthread_mutex_unlock(&srv->lock);
     apply_reverts(srv);

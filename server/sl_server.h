@@ -93,6 +93,8 @@ typedef struct sl_dataset_load sl_dataset_load;  /* dataset_cache.c */
                                           one more ends the link (1008 "reply budget") */
 #define SL_CLOSE_REASON_MAX 124        /* a close frame's reason with its NUL (RFC 6455: 123 bytes) */
 #define SL_CLOSE_GRACE_S 5             /* a link told to close that cannot take its close frame is dropped */
+#define SL_CLOSE_POLICY_VIOLATION 1008 /* RFC 6455 close codes the sessions use */
+#define SL_CLOSE_UNEXPECTED_CONDITION 1011
 #define SL_SESSION_MAX_SNAPSHOTS 8     /* pending snapshot requests per session */
 #define SL_SOURCE_MAX 2048
 #define SL_PROGRESS_RING 8             /* newest progress texts kept per session: two full rounds */
@@ -279,7 +281,8 @@ typedef struct sl_reply {
 } sl_reply;
 
 struct sl_client {                  /* [service] */
-    struct lws *wsi;
+    void *link;                     /* the transport's handle of the connection (ws.c: its struct lws) */
+    const struct sl_transport_hooks *transport; /* how the layers below the transport reach it for c */
     int id;
     char addr[SL_CLIENT_ADDRESS_MAX]; /* client address, numeric (sl_ws_client_address) */
     sl_session *session;            /* NULL before hello */
@@ -410,8 +413,15 @@ typedef struct sl_server sl_server;
 typedef struct sl_transport_hooks {
     void (*schedule_play)(sl_server *srv, double ms); /* run sl_play_tick in ms from now (replacing an
                                                          earlier schedule) */
-    void (*hello_done)(sl_server *srv, sl_client *c); /* c no longer waits for hello (it said hello or
-                                                         closes); no-op when it was not pending */
+    void (*hello_done)(sl_server *srv, sl_client *c); /* c said hello: it no longer waits for it (its
+                                                         hello timeout ends) */
+    void (*want_write)(sl_client *c);                /* c has something to send: call sl_client_write_next
+                                                         for it soon */
+    void (*closing)(sl_client *c);                   /* c was told to close (sl_client_close): drop the link
+                                                         if it cannot take the close frame within
+                                                         SL_CLOSE_GRACE_S */
+    void (*wake_service)(sl_server *srv);            /* any thread (the render thread): the service thread
+                                                         runs sl_sessions_on_wake soon */
 } sl_transport_hooks;
 
 struct sl_server {
@@ -462,6 +472,8 @@ cJSON *sl_session_state_json(const sl_session *s);
  * reply budget is used up (the link then ends with 1008 "reply budget"), or
  * on a NULL text (out of memory: 1011); the text is freed either way. */
 int sl_client_queue_text(sl_client *c, char *text);
+/* c has something to send: the transport calls sl_client_write_next for it soon. */
+void sl_client_wake(sl_client *c);
 /* Queues an `error`, merged into a queued one of the same code and field
  * when there is one (its `repeated` counts the others; the newest message
  * wins). Returns -1 as sl_client_queue_text. */

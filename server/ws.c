@@ -212,14 +212,15 @@ static int callback_ws(struct lws *wsi, enum lws_callback_reasons reason, void *
         }
         if (srv->pending_count >= srv->cfg.max_pending)
             evict_oldest_pending(srv);
-        c->wsi = wsi;
+        c->link = wsi;
+        c->transport = &srv->transport;
         c->id = ++srv->next_client_id;
         c->pending = 1;
         c->pending_next = srv->pending;
         srv->pending = c;
         pss->client = c;
         /* hello must come within --hello-timeout s (LWS_CALLBACK_TIMER closes with 1008; both are
-         * cleared in session.c when it comes; the timeout drops a link that cannot take the close). */
+         * cleared by hello_done when it comes; the timeout drops a link that cannot take the close). */
         lws_set_timer_usecs(wsi, (lws_usec_t)srv->cfg.hello_timeout_s * LWS_USEC_PER_SEC);
         lws_set_timeout(wsi, PENDING_TIMEOUT_USER_REASON_BASE + 1, srv->cfg.hello_timeout_s + SL_CLOSE_GRACE_S);
         pthread_mutex_lock(&srv->lock);
@@ -433,6 +434,24 @@ static void play_cb(lws_sorted_usec_list_t *sul)
         lws_sul_schedule(play_timer.srv->lws, 0, &play_timer.sul, play_cb, (lws_usec_t)(next_ms * 1000.0) + 1);
 }
 
+/* sl_transport_hooks for the sessions (service thread). */
+static void hello_done(sl_server *srv, sl_client *c)
+{
+    pending_leave(srv, c);
+    lws_set_timeout(c->link, NO_PENDING_TIMEOUT, 0);
+    lws_set_timer_usecs(c->link, LWS_SET_TIMER_USEC_CANCEL); /* the hello timeout */
+}
+
+static void want_write(sl_client *c) { lws_callback_on_writable(c->link); }
+
+static void wake_service(sl_server *srv) { lws_cancel_service(srv->lws); }
+
+static void closing(sl_client *c)
+{
+    lws_set_timeout(c->link, PENDING_TIMEOUT_CLOSE_SEND, SL_CLOSE_GRACE_S);
+    lws_callback_on_writable(c->link);
+}
+
 static void schedule_play(sl_server *srv, double ms)
 {
     play_timer.srv = srv;
@@ -442,7 +461,9 @@ static void schedule_play(sl_server *srv, double ms)
 sl_status sl_ws_create(sl_server *srv, int *port, sl_err *err)
 {
     lws_set_log_level(LLL_ERR | LLL_WARN, NULL);
-    srv->transport = (sl_transport_hooks){.schedule_play = schedule_play, .hello_done = pending_leave};
+    srv->transport = (sl_transport_hooks){.schedule_play = schedule_play, .hello_done = hello_done,
+                                          .want_write = want_write, .closing = closing,
+                                          .wake_service = wake_service};
     mount_root.origin = srv->cfg.web_dir;
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);
