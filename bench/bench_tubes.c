@@ -251,6 +251,32 @@ static sl_status fixed_camera(const sl_dataset *ds, int frame, int frames, const
     return SL_OK;
 }
 
+/* One row of the error table: the pipeline's technique (set by the caller) rendered 3 times at
+ * the view's size (median ms), its distances against the reference, and its frame ms at the
+ * benchmark size. */
+static sl_status measure(sl_pipeline *p, const sl_technique *tubes, const sl_params *params, const sl_view *view,
+                         const sl_bench_options *one, float *gpu_d, const float *ref, const float *rad,
+                         error_stats *e, double *small_ms, double *big_ms, sl_err *err)
+{
+    double ms[3];
+    sl_frame_stats stats;
+    sl_status st;
+    for (int f = 0; f < 3; f++) {
+        if ((st = sl_pipeline_render(p, view, 1, &stats, err)) != SL_OK)
+            return st;
+        ms[f] = stats.wall_ms;
+    }
+    sl_pipeline_read_distance(p, view, gpu_d);
+    sl_bench_timing big;
+    if ((st = sl_bench_time_frames(p, tubes, params, one, SL_QUALITY_STILL, fixed_camera, &view->camera, &big, err)) !=
+        SL_OK)
+        return st;
+    *e = compare(gpu_d, ref, rad, view->width, view->height);
+    *small_ms = median(ms, 3);
+    *big_ms = big.median_ms;
+    return SL_OK;
+}
+
 static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
 {
     const char *json = "{\"generator\":\"bundle\",\"lines\":100,\"points\":50,\"seed\":2}";
@@ -317,44 +343,26 @@ static sl_status bench_error(sl_gpu *gpu, const options *o, sl_err *err)
             sl_params_set_choice(&params, "root_method", methods[m], err);
             if ((st = sl_pipeline_set_technique(p, tubes, &params, err)) != SL_OK)
                 goto done;
-            double ms[3];
-            sl_frame_stats stats;
-            for (int f = 0; f < 3; f++) {
-                if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
-                    goto done;
-                ms[f] = stats.wall_ms;
-            }
-            sl_pipeline_read_distance(p, &view, gpu_d);
-            sl_bench_timing big;
-            if ((st = sl_bench_time_frames(p, tubes, &params, &one, SL_QUALITY_STILL, fixed_camera, &view.camera, &big,
-                                           err)) != SL_OK)
+            error_stats e;
+            double small_ms, big_ms;
+            if ((st = measure(p, tubes, &params, &view, &one, gpu_d, ref, rad, &e, &small_ms, &big_ms, err)) != SL_OK)
                 goto done;
-            error_stats e = compare(gpu_d, ref, rad, w, h);
             for (int l = 0; l < NL; l++)
                 if (need[m][l] < 0 && e.max_inner <= levels[l] && e.mean <= 0.1 * levels[l])
                     need[m][l] = iters[k];
             printf("| %s | %d | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f | %.1f |\n", methods[m], iters[k],
-                   e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3), big.median_ms);
+                   e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, small_ms, big_ms);
             fflush(stdout);
         }
     }
     if (sl_params_set_choice(&params, "backend", "embree", err) == SL_OK &&
         sl_pipeline_set_technique(p, tubes, &params, err) == SL_OK) {
-        double ms[3];
-        sl_frame_stats stats;
-        for (int f = 0; f < 3; f++) {
-            if ((st = sl_pipeline_render(p, &view, 1, &stats, err)) != SL_OK)
-                goto done;
-            ms[f] = stats.wall_ms;
-        }
-        sl_pipeline_read_distance(p, &view, gpu_d);
-        sl_bench_timing big;
-        if ((st = sl_bench_time_frames(p, tubes, &params, &one, SL_QUALITY_STILL, fixed_camera, &view.camera, &big,
-                                       err)) != SL_OK)
+        error_stats e;
+        double small_ms, big_ms;
+        if ((st = measure(p, tubes, &params, &view, &one, gpu_d, ref, rad, &e, &small_ms, &big_ms, err)) != SL_OK)
             goto done;
-        error_stats e = compare(gpu_d, ref, rad, w, h);
         printf("| backend=embree (exact double where bent) | - | %.3g | %.3g | %.3g | %ld / %ld | %ld | %.1f | %.1f |\n",
-               e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, median(ms, 3), big.median_ms);
+               e.max_inner, e.max_all, e.mean, e.away, e.both, e.mismatch, small_ms, big_ms);
     } else {
         printf("| backend=embree | - | not built: %s | | | | | | |\n", err->message);
     }
