@@ -49,6 +49,21 @@ static __attribute__((unused)) const char *sl_cluster_bin_dir(void)
  * (NULL-terminated, may be NULL; passed after `--`, so they win over the
  * script's). Returns 0 once HAProxy answers, or -1 (the reason on stderr);
  * call sl_cluster_stop on both paths. The script's lines are echoed to stderr. */
+/* 1 when a TCP socket can bind 127.0.0.1:port now. */
+static __attribute__((unused)) int sl_cluster_port_free(int port)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0)
+        return 0;
+    int one = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    int ok = bind(fd, (struct sockaddr *)&a, sizeof a) == 0;
+    close(fd);
+    return ok;
+}
+
 static __attribute__((unused)) int sl_cluster_start(sl_cluster *c, int nodes, const char *const *server_args)
 {
     memset(c, 0, sizeof *c);
@@ -63,10 +78,22 @@ static __attribute__((unused)) int sl_cluster_start(sl_cluster *c, int nodes, co
         return -1;
     }
     c->port = harness_free_port();
-    int base = harness_free_port();
-    if (c->port <= 0 || base <= 0 || base > 60000)
+    /* node ports base+i, agents base+100+i: a base whose ports are all free now (a port taken
+     * by another process made a node fail to listen, and the test with it) */
+    int base = -1;
+    for (int attempt = 0; attempt < 20 && base < 0; attempt++) {
+        int b = harness_free_port();
+        if (b <= 0 || b > 60000)
+            continue;
+        b -= b % 100;
+        int all_free = 1;
+        for (int i = 1; i <= nodes && all_free; i++)
+            all_free = sl_cluster_port_free(b + i) && sl_cluster_port_free(b + 100 + i);
+        if (all_free)
+            base = b;
+    }
+    if (c->port <= 0 || base <= 0)
         return -1;
-    base = base - base % 100; /* node ports base+i, agents base+100+i */
     char script[512], portv[16], basev[16], nodesv[16];
     snprintf(script, sizeof script, "%s/scripts/cluster", sl_cluster_src_dir());
     snprintf(portv, sizeof portv, "%d", c->port);
