@@ -25,7 +25,7 @@
  * --port 0 picks a free port; the chosen one is printed as
  * "listening on http://ADDR:PORT/" on stdout (tests read it).
  */
-#include "sl_server.h"
+#include "net/sl_net.h"
 
 #include <errno.h>
 #include <limits.h>

@@ -12,7 +12,7 @@
  *      from clients or a catalog.
  * A bare word that is neither a built-in nor a file is reported as a
  * probably mistyped name, listing the built-ins. proto/scene.c (CLI, tests)
- * and server/dataset_cache.c both open datasets only through here. Any thread.
+ * and server/render/dataset_cache.c both open datasets only through here. Any thread.
  */
 #ifndef SL_DATASET_OPEN_H
 #define SL_DATASET_OPEN_H

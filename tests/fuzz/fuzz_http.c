@@ -1,5 +1,5 @@
 /* fuzz_http.c — the Host and Origin rules of sightline-server
- * (server/http_host.c, sl_http_host.h) on arbitrary header values.
+ * (server/net/http_host.c, sl_http_host.h) on arbitrary header values.
  *
  * libwebsockets parses the request line and headers; what the server adds
  * is the decision on the Host and Origin values, which is what this drives.

@@ -3,7 +3,7 @@
  *
  * The input is a conversation: messages separated by '\n' (JSON needs none
  * inside a message). Each goes through what the server does with it
- * (server/ws.c, session.c): over SL_PROTO_MAX_HELLO bytes before hello, or
+ * (server/net/ws.c, sessions/session.c): over SL_PROTO_MAX_HELLO bytes before hello, or
  * SL_PROTO_MAX_MESSAGE after, closes the connection; sl_msg_parse; before
  * hello a parse error or any other type closes it, a hello opens it; after
  * hello a second hello is refused, a camera goes through

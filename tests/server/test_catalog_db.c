@@ -24,7 +24,7 @@
 #include "core/sl_clock.h"
 #include "data/sl_dataset.h"
 #include "data/sl_generate.h"
-#include "sl_catalog.h"
+#include "catalog/sl_catalog.h"
 #include "sl_test.h"
 
 static char tmp_dir[64];      /* data directory and SQLite files */

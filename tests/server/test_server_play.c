@@ -1,4 +1,4 @@
-/* test_server_play.c — live path playback and path_seek (server/playback.c; PROTOCOL.md "Playback").
+/* test_server_play.c — live path playback and path_seek (server/sessions/playback.c; PROTOCOL.md "Playback").
  *
  * One session, two clients at 64x48: A (controller) and B (viewer). A plays
  * a 3-key linear orbit path (azimuth 0, 60, 120 at t = 0, 0.75, 1.5 s; 10

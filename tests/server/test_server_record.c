@@ -1,4 +1,4 @@
-/* test_server_record.c — recording jobs (server/record.c, render.c do_record; PROTOCOL.md "Recordings").
+/* test_server_record.c — recording jobs (server/sessions/record.c, render/render_record.c; PROTOCOL.md "Recordings").
  *
  * One session, two clients: A (controller) and B (viewer), 64x48. The
  * server runs with --test-frame-fixed-ms 40, so a 25-frame job takes over a

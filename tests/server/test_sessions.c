@@ -18,7 +18,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sl_server.h"
+#include "sessions/sl_sessions.h"
 #include "sl_test.h"
 
 static int wakes[8], closings[8], hellos, play_schedules;
@@ -127,27 +127,27 @@ int main(void)
     /* the viewer's camera is refused; its own reply names why */
     const char *camera = "{\"type\":\"camera\",\"seq\":1,\"phase\":\"move\","
                          "\"camera\":{\"orbit\":{\"azimuth\":75,\"elevation\":12,\"distance\":2.1},\"fov_y\":45}}";
-    uint32_t v0 = s->state.version;
+    uint32_t v0 = s->slot.state.version;
     say(srv, &b, camera);
     SL_CHECK_MSG(strcmp(last_reply(&b, reply, sizeof reply), "not_controller") == 0, "%s", reply);
-    SL_CHECK(s->state.version == v0);
+    SL_CHECK(s->slot.state.version == v0);
     drain_replies(&b);
 
     /* set by the controller: a render request, and a patch for the viewer */
     pthread_mutex_lock(&srv->lock);
-    s->rendered_version = s->state.version; /* as if the render thread had drawn it */
+    s->slot.rendered_version = s->slot.state.version; /* as if the render thread had drawn it */
     SL_CHECK(sl_sessions_render_queue_locked(srv) == 0);
     pthread_mutex_unlock(&srv->lock);
     int b_wakes = wakes[2];
     say(srv, &a, "{\"type\":\"set\",\"background\":[1,1,1,1]}");
-    SL_CHECK(s->state.version == v0 + 1 && s->state.background[0] == 1.0f);
+    SL_CHECK(s->slot.state.version == v0 + 1 && s->slot.state.background[0] == 1.0f);
     pthread_mutex_lock(&srv->lock);
     SL_CHECK(sl_sessions_render_queue_locked(srv) == 1);
     pthread_mutex_unlock(&srv->lock);
     SL_CHECK(patch_has(&b, "background") && wakes[2] > b_wakes);
     /* a second change merges into the one pending patch (newest value wins) */
     say(srv, &a, "{\"type\":\"set\",\"background\":[0,0,0,1]}");
-    SL_CHECK(patch_has(&b, "background") && b.patch_version == s->state.version);
+    SL_CHECK(patch_has(&b, "background") && b.patch_version == s->slot.state.version);
     const cJSON *bg = cJSON_GetObjectItemCaseSensitive(b.patch, "background");
     SL_CHECK(cJSON_IsArray(bg) && cJSON_GetArrayItem(bg, 0) && cJSON_GetArrayItem(bg, 0)->valuedouble == 0.0);
     drop_patch(&a);
@@ -164,9 +164,9 @@ int main(void)
     drop_patch(&b);
 
     /* now b's camera is accepted and reaches a */
-    uint32_t v1 = s->state.version;
+    uint32_t v1 = s->slot.state.version;
     say(srv, &b, camera);
-    SL_CHECK(s->state.version == v1 + 1 && s->state.camera_seq == 1 && s->state.phase == SL_PHASE_MOVE);
+    SL_CHECK(s->slot.state.version == v1 + 1 && s->slot.state.camera_seq == 1 && s->slot.state.phase == SL_PHASE_MOVE);
     SL_CHECK(patch_has(&a, "camera") && b.reply_count == 0);
     drop_patch(&a);
     drop_patch(&b);
@@ -176,9 +176,9 @@ int main(void)
                  "{\"azimuth\":0}}},{\"t\":4,\"camera\":{\"orbit\":{\"azimuth\":90}}}]},\"loop\":false}");
     SL_CHECK_MSG(s->play != NULL && play_schedules == 1 && last_schedule_ms == 0.0, "%s",
                  last_reply(&b, reply, sizeof reply));
-    uint32_t v2 = s->state.version;
+    uint32_t v2 = s->slot.state.version;
     double next = sl_play_tick(srv);
-    SL_CHECK(s->state.version > v2 && patch_has(&a, "camera") && next >= 0.0 && next <= 1000.0 / 24.0 + 1.0);
+    SL_CHECK(s->slot.state.version > v2 && patch_has(&a, "camera") && next >= 0.0 && next <= 1000.0 / 24.0 + 1.0);
     /* the controller's own camera stops it */
     say(srv, &b, camera);
     SL_CHECK(s->play == NULL && sl_play_tick(srv) < 0.0);
@@ -193,10 +193,10 @@ int main(void)
     sl_sessions_on_close(srv, &a);
     SL_CHECK(s->client_count == 0 && s->empty_since_ms > 0.0);
     sl_sessions_sweep(srv);
-    SL_CHECK(srv->session_count == 1 && !s->doomed); /* grace not over */
+    SL_CHECK(srv->session_count == 1 && !s->slot.doomed); /* grace not over */
     srv->cfg.grace_s = 0;
     sl_sessions_sweep(srv);
-    SL_CHECK(srv->session_count == 0 && s->doomed);
+    SL_CHECK(srv->session_count == 0 && s->slot.doomed);
 
     sl_sessions_destroy_all(srv);
     cJSON_Delete(srv->techniques_json);

@@ -7,38 +7,15 @@
  *
  * Metrics are counters and gauges read under srv->lock in one pass, so a
  * scrape sees one consistent snapshot; the two histograms (render ms and
- * encode ms per frame) use fixed millisecond buckets. Does not send
- * anything (ws.c does). Service thread; sl_histogram_add is called by the
- * render thread with the lock held.
+ * encode ms per frame) use the fixed millisecond buckets of
+ * server_metrics.c. Does not send anything (ws.c does). Service thread.
  */
-#include "sl_server.h"
+#include "sl_net.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static const double bucket_ms[SL_HIST_BUCKETS - 1] = {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 5000};
-
-const char *const sl_metric_backend_names[SL_METRIC_BACKENDS] = {"gl", "embree", "cpu", "single"};
-
-int sl_metric_backend_index(const char *backend)
-{
-    for (int i = 0; backend && i < SL_METRIC_BACKENDS - 1; i++)
-        if (!strcmp(backend, sl_metric_backend_names[i]))
-            return i;
-    return SL_METRIC_BACKENDS - 1;
-}
-
-void sl_histogram_add(sl_histogram *h, double ms)
-{
-    for (int i = 0; i < SL_HIST_BUCKETS - 1; i++)
-        if (ms <= bucket_ms[i])
-            h->counts[i]++;
-    h->counts[SL_HIST_BUCKETS - 1]++;
-    h->sum += ms;
-    h->total++;
-}
 
 char *sl_http_healthz(sl_server *srv, int *status)
 {
@@ -95,7 +72,7 @@ static void histogram(char **b, size_t *len, size_t *cap, const char *name, cons
 {
     append(b, len, cap, "# HELP %s %s\n# TYPE %s histogram\n", name, help, name);
     for (int i = 0; i < SL_HIST_BUCKETS - 1; i++)
-        append(b, len, cap, "%s_bucket{le=\"%g\"} %llu\n", name, bucket_ms[i], (unsigned long long)h->counts[i]);
+        append(b, len, cap, "%s_bucket{le=\"%g\"} %llu\n", name, sl_histogram_bucket_ms[i], (unsigned long long)h->counts[i]);
     append(b, len, cap, "%s_bucket{le=\"+Inf\"} %llu\n", name, (unsigned long long)h->counts[SL_HIST_BUCKETS - 1]);
     append(b, len, cap, "%s_sum %.3f\n%s_count %llu\n", name, h->sum, name, (unsigned long long)h->total);
 }

@@ -5,7 +5,7 @@
  * A header from any other peer is ignored and counted. Service thread, inside
  * the lws callbacks of an upgrade (the request headers are still attached).
  */
-#include "sl_server.h"
+#include "sl_net.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -17,7 +17,7 @@
  * connection closed. Runs on its own thread; it only reads the counts under
  * sl_server.lock. Not here: the HTTP health check (http.c).
  */
-#include "sl_server.h"
+#include "sl_net.h"
 
 #include <arpa/inet.h>
 #include <errno.h>

@@ -1,6 +1,6 @@
-/* random_hex.c — sl_random_hex (sl_server.h): random lowercase hex for session ids, tokens and
+/* random_hex.c — sl_random_hex (sl_sessions.h): random lowercase hex for session ids, tokens and
  * recording keys. Any thread. */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>

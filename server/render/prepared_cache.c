@@ -18,7 +18,7 @@
  * it (GL objects too). Render thread only (it owns every GL object), so no
  * lock. Does not load datasets (dataset_cache.c does).
  */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -30,7 +30,7 @@
  * The render thread wakes this thread with lws_cancel_service, which arrives
  * as LWS_CALLBACK_EVENT_WAIT_CANCELLED. Never calls GL.
  */
-#include "sl_server.h"
+#include "sl_net.h"
 #include "sl_http_host.h"
 
 #include <stdio.h>

@@ -8,7 +8,7 @@
  * Does not render or send. The encoder runs on the render thread; refcounts
  * are atomic because the service thread drops references.
  */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -2,7 +2,7 @@
  * frame of the job's path into its video writer (the session's interactive frames keep going
  * between calls), finishes the file after the last, or removes it when cancelled or failed;
  * the job's `recording` texts say which. Render thread. */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +18,7 @@
 #include "sl_scene_path.h"
 
 /* Ends the session's recording job with `state` (and extra fields, consumed). */
-static void record_finish(sl_server *srv, sl_session *s, sl_record_job *j, const char *state, int ok, cJSON *extra)
+static void record_finish(sl_server *srv, sl_render_slot *s, sl_record_job *j, const char *state, int ok, cJSON *extra)
 {
     pthread_mutex_lock(&srv->lock);
     j->finished = 1;
@@ -27,7 +27,7 @@ static void record_finish(sl_server *srv, sl_session *s, sl_record_job *j, const
     pthread_mutex_unlock(&srv->lock);
 }
 
-static void record_fail(sl_server *srv, sl_session *s, sl_record_job *j, int frame, const sl_err *err)
+static void record_fail(sl_server *srv, sl_render_slot *s, sl_record_job *j, int frame, const sl_err *err)
 {
     sl_video_abort(j->writer);
     j->writer = NULL;
@@ -43,7 +43,7 @@ static void record_fail(sl_server *srv, sl_session *s, sl_record_job *j, int fra
  * t = frame / fps, through the session's prepared scene (ready_scene
  * switches scenes when a keyed parameter needs another prepare: costly,
  * as scene.md says). The session's latest frame and state are untouched. */
-void sl_render_record(render_ctx *ctx, sl_session *s, sl_record_job *j, int cancel)
+void sl_render_record(render_ctx *ctx, sl_render_slot *s, sl_record_job *j, int cancel)
 {
     sl_server *srv = ctx->srv;
     if (cancel) {

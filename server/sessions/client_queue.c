@@ -1,7 +1,7 @@
 /* client_queue.c — what a client is sent in reply to its own requests (the reply ring: its
  * budget, errors merged by code and field) and the request to end its link with a close
  * frame; the error replies count in the metrics. Service thread. */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>

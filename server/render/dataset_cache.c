@@ -25,7 +25,7 @@
  * the queue is bounded by --max-sessions; a queued load nobody waits for any
  * more is dropped.
  */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,6 +1,6 @@
 /* session_drain.c — the end of sessions: the grace-period sweep, draining (SIGTERM: no new
  * sessions, checkpoints handed over at the end) and the teardown at exit. Service thread. */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,13 +12,13 @@ void sl_sessions_sweep(sl_server *srv)
     /* One expired session per pass under the lock; its catalog row is deleted
      * after unlocking, so a WAL commit never stalls the render thread. */
     for (;;) {
-        char id[sizeof srv->sessions->id] = "";
+        char id[SL_SESSION_ID_SIZE] = "";
         pthread_mutex_lock(&srv->lock);
-        for (sl_session *s = srv->sessions; s && !id[0]; s = s->next) {
-            if (s->doomed || s->client_count > 0 || now - s->empty_since_ms < srv->cfg.grace_s * 1000.0)
+        for (sl_session *s = sl_sessions_first(srv); s && !id[0]; s = sl_session_next(s)) {
+            if (s->slot.doomed || s->client_count > 0 || now - s->empty_since_ms < srv->cfg.grace_s * 1000.0)
                 continue;
             memcpy(id, s->id, sizeof id);
-            s->doomed = 1;   /* the render thread may free it from here on */
+            s->slot.doomed = 1;   /* the render thread may free it from here on */
             srv->session_count--;
             pthread_cond_signal(&srv->wake);
         }
@@ -34,12 +34,12 @@ void sl_sessions_sweep(sl_server *srv)
 void sl_sessions_destroy_all(sl_server *srv)
 {
     pthread_mutex_lock(&srv->lock);
-    sl_session *s = srv->sessions;
-    srv->sessions = NULL;
+    sl_render_slot *s = srv->slots;
+    srv->slots = NULL;
     pthread_mutex_unlock(&srv->lock);
     while (s) {
-        sl_session *next = s->next;
-        sl_session_free(s);
+        sl_render_slot *next = s->next;
+        s->destroy(s);
         s = next;
     }
 }
@@ -59,8 +59,8 @@ int sl_sessions_drain_done(sl_server *srv)
 {
     int busy = 0;
     pthread_mutex_lock(&srv->lock);
-    for (sl_session *s = srv->sessions; s && !busy; s = s->next)
-        busy = !s->doomed && s->client_count > 0;
+    for (sl_session *s = sl_sessions_first(srv); s && !busy; s = sl_session_next(s))
+        busy = !s->slot.doomed && s->client_count > 0;
     pthread_mutex_unlock(&srv->lock);
     if (busy && sl_clock_ms() - srv->drain_start_ms < srv->cfg.grace_s * 1000.0)
         return 0;
@@ -69,8 +69,8 @@ int sl_sessions_drain_done(sl_server *srv)
     pthread_mutex_lock(&srv->lock);
     int n = 0, cap = srv->session_count;
     sl_session **live = cap > 0 ? malloc(sizeof *live * (size_t)cap) : NULL;
-    for (sl_session *s = srv->sessions; s && live && n < cap; s = s->next)
-        if (!s->doomed)
+    for (sl_session *s = sl_sessions_first(srv); s && live && n < cap; s = sl_session_next(s))
+        if (!s->slot.doomed)
             live[n++] = s;
     pthread_mutex_unlock(&srv->lock);
     for (int i = 0; i < n; i++) /* valid outside the lock: only this thread dooms a session */

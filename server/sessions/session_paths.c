@@ -1,7 +1,7 @@
 /* session_paths.c — the handlers of the messages about camera paths and recordings: record,
  * record_cancel, play_path / play_stop / path_seek (playback.c does the work), save_path,
  * load_path. Control is checked by the dispatch (session.c). Service thread. */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,7 +17,7 @@ void sl_on_record(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
     pthread_mutex_lock(&srv->lock);
-    int busy = s->record && !s->record->finished;
+    int busy = s->slot.record && !s->slot.record->finished;
     pthread_mutex_unlock(&srv->lock);
     if (busy) {
         sl_client_send_error(srv, c, "busy", "a recording is already running in this session (record_cancel stops it)", "type");
@@ -30,9 +30,9 @@ void sl_on_record(sl_server *srv, sl_client *c, const sl_msg *m)
         return;
     }
     pthread_mutex_lock(&srv->lock);
-    sl_record_job *old = s->record; /* finished: no thread works on it */
-    s->record = j;
-    sl_record_status_locked(s, j, "queued", NULL);
+    sl_record_job *old = s->slot.record; /* finished: no thread works on it */
+    s->slot.record = j;
+    sl_record_status_locked(&s->slot, j, "queued", NULL);
     pthread_cond_signal(&srv->wake);
     pthread_mutex_unlock(&srv->lock);
     sl_record_free(old);
@@ -46,9 +46,9 @@ void sl_on_record_cancel(sl_server *srv, sl_client *c, const sl_msg *m)
     (void)m;
     sl_session *s = c->session;
     pthread_mutex_lock(&srv->lock);
-    int running = s->record && !s->record->finished;
+    int running = s->slot.record && !s->slot.record->finished;
     if (running) {
-        s->record->cancel = 1;
+        s->slot.record->cancel = 1;
         pthread_cond_signal(&srv->wake);
     }
     pthread_mutex_unlock(&srv->lock);
@@ -81,7 +81,7 @@ void sl_on_save_path(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
     sl_err err = {0};
-    const sl_technique *t = sl_technique_find(s->state.technique);
+    const sl_technique *t = sl_technique_find(s->slot.state.technique);
     sl_scene_path *p = NULL;
     if (!t || sl_scene_path_parse(m->path, t, &p, &err) != SL_OK) {
         sl_client_send_error(srv, c, "bad_field", t ? err.message : "the session's technique is not in this build", "path");

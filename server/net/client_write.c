@@ -3,7 +3,7 @@
  * control requests (to the controller), the session's progress texts, its newest error,
  * recording and playback texts, a snapshot, the newest frame within the ack window.
  * Service thread. */
-#include "sl_server.h"
+#include "sl_net.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -87,32 +87,32 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
      * load's `done` precedes its load_failed. */
     char *progress = NULL;
     pthread_mutex_lock(&srv->lock);
-    if (c->progress_seq != s->progress_seq) {
-        uint32_t next = c->progress_seq + 1, oldest = s->progress_seq - (SL_PROGRESS_RING - 1);
-        if (s->progress_seq >= SL_PROGRESS_RING && next < oldest)
+    if (c->progress_seq != s->slot.progress_seq) {
+        uint32_t next = c->progress_seq + 1, oldest = s->slot.progress_seq - (SL_PROGRESS_RING - 1);
+        if (s->slot.progress_seq >= SL_PROGRESS_RING && next < oldest)
             next = oldest;
         c->progress_seq = next;
-        progress = strdup(s->progress_text[next % SL_PROGRESS_RING]);
+        progress = strdup(s->slot.progress_text[next % SL_PROGRESS_RING]);
     }
     pthread_mutex_unlock(&srv->lock);
     if (progress)
         return write_text_now(c, progress);
     char *error = NULL;
     pthread_mutex_lock(&srv->lock);
-    if (c->error_seq != s->error_seq) {
-        c->error_seq = s->error_seq;
+    if (c->error_seq != s->slot.error_seq) {
+        c->error_seq = s->slot.error_seq;
         srv->metrics.errors_sent++;
-        int load = strcmp(s->error_code, "load_failed") == 0;
-        error = sl_msg_error_text(load ? "load_failed" : "render_failed", s->error_text, load ? "dataset" : "");
+        int load = strcmp(s->slot.error_code, "load_failed") == 0;
+        error = sl_msg_error_text(load ? "load_failed" : "render_failed", s->slot.error_text, load ? "dataset" : "");
     }
     pthread_mutex_unlock(&srv->lock);
     if (error)
         return write_text_now(c, error);
     char *recording = NULL;
     pthread_mutex_lock(&srv->lock);
-    if (c->record_seq != s->record_seq) {
-        c->record_seq = s->record_seq;
-        recording = s->record_text ? strdup(s->record_text) : NULL;
+    if (c->record_seq != s->slot.record_seq) {
+        c->record_seq = s->slot.record_seq;
+        recording = s->slot.record_text ? strdup(s->slot.record_text) : NULL;
     }
     pthread_mutex_unlock(&srv->lock);
     if (recording)
@@ -132,8 +132,8 @@ int sl_client_write_next(sl_server *srv, sl_client *c)
     }
     sl_frame_buf *f = NULL;
     pthread_mutex_lock(&srv->lock);
-    if (s->latest && s->latest->header.frame_id > c->sent_frame_id && c->inflight_count < SL_PROTO_ACK_WINDOW) {
-        f = s->latest;
+    if (s->slot.latest && s->slot.latest->header.frame_id > c->sent_frame_id && c->inflight_count < SL_PROTO_ACK_WINDOW) {
+        f = s->slot.latest;
         sl_frame_buf_ref(f);
         if (c->sent_frame_id)
             srv->metrics.frames_dropped += f->header.frame_id - c->sent_frame_id - 1;

@@ -11,13 +11,13 @@
  * behind skips the oldest). A post wakes the service thread at once, so the
  * message leaves before the long step it announces starts.
  */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 
-static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double render_ms, uint32_t frame, int ok)
+static void post(sl_server *srv, sl_render_slot *s, sl_progress_stage stage, double render_ms, uint32_t frame, int ok)
 {
     sl_progress_round *r = &s->round;
     sl_msg_progress m = {.stage = stage, .round = r->id, .version = r->version, .dataset = r->dataset,
@@ -38,7 +38,7 @@ static void post(sl_server *srv, sl_session *s, sl_progress_stage stage, double 
         srv->transport.wake_service(srv);
 }
 
-void sl_progress_begin(sl_server *srv, sl_session *s, const sl_session_state *st)
+void sl_progress_begin(sl_server *srv, sl_render_slot *s, const sl_session_state *st)
 {
     if (s->round.active)
         sl_progress_end(srv, s, 0, 0, 0);
@@ -57,7 +57,7 @@ void sl_progress_begin(sl_server *srv, sl_session *s, const sl_session_state *st
     r->stage = -1;
 }
 
-void sl_progress_stage_post(sl_server *srv, sl_session *s, sl_progress_stage stage)
+void sl_progress_stage_post(sl_server *srv, sl_render_slot *s, sl_progress_stage stage)
 {
     if (!s->round.active || (int)stage <= s->round.stage || stage == SL_PROGRESS_DONE)
         return;
@@ -65,7 +65,7 @@ void sl_progress_stage_post(sl_server *srv, sl_session *s, sl_progress_stage sta
     post(srv, s, stage, 0, 0, 0);
 }
 
-void sl_progress_end(sl_server *srv, sl_session *s, int ok, double render_ms, uint32_t frame)
+void sl_progress_end(sl_server *srv, sl_render_slot *s, int ok, double render_ms, uint32_t frame)
 {
     if (!s->round.active)
         return;

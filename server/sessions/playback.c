@@ -16,7 +16,7 @@
  * Service thread only (the state's one writer); the render thread never
  * reads these fields.
  */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -75,9 +75,9 @@ static int has_keyed_params(const sl_scene_path *p)
  * needs the dataset's bounds, known once it has loaded. */
 static sl_status parse_path(const sl_session *s, const cJSON *obj, sl_scene_path **out, sl_err *err)
 {
-    const sl_technique *t = sl_technique_find(s->state.technique);
+    const sl_technique *t = sl_technique_find(s->slot.state.technique);
     if (!t)
-        return sl_err_set(err, SL_ERR_INVALID, "technique %s is not in this build", s->state.technique);
+        return sl_err_set(err, SL_ERR_INVALID, "technique %s is not in this build", s->slot.state.technique);
     sl_status st = sl_scene_path_parse(obj, t, out, err);
     if (st != SL_OK)
         return st;
@@ -86,7 +86,7 @@ static sl_status parse_path(const sl_session *s, const cJSON *obj, sl_scene_path
         sl_scene_path_destroy(*out);
         *out = NULL;
         return sl_err_set(err, SL_ERR_INVALID, "path: a path with eye/target keys needs the dataset's bounds, "
-                          "which are known once \"%s\" has loaded; retry after its first frame", s->state.dataset);
+                          "which are known once \"%s\" has loaded; retry after its first frame", s->slot.state.dataset);
     }
     return SL_OK;
 }
@@ -105,7 +105,7 @@ static sl_status apply_at(sl_server *srv, sl_session *s, const sl_scene_path *p,
         sl_session_set_view(srv, s, &cam, NULL, phase);
         return SL_OK;
     }
-    const sl_technique *tech = sl_technique_find(s->state.technique);
+    const sl_technique *tech = sl_technique_find(s->slot.state.technique);
     cJSON *keyed = tech ? sl_scene_path_params(p, t, NULL, tech) : NULL;
     if (!keyed)
         return sl_err_set(err, SL_ERR_NOMEM, "out of memory for the path's parameters at t = %g", t);
@@ -133,7 +133,7 @@ sl_status sl_play_start(sl_server *srv, sl_session *s, const cJSON *path, int lo
     sl_scene_path_destroy(s->play);
     s->play = p;
     s->play_loop = loop;
-    s->play_base = s->state.params;
+    s->play_base = s->slot.state.params;
     s->play_frame = -1;
     s->play_t0_ms = sl_clock_ms();
     if (srv->transport.schedule_play)
@@ -160,7 +160,7 @@ sl_status sl_play_seek(sl_server *srv, sl_session *s, const cJSON *path, double 
     if (st != SL_OK)
         return st;
     sl_play_stop(srv, s, "seek");
-    st = apply_at(srv, s, p, &s->state.params, t, SL_PHASE_NONE, err);
+    st = apply_at(srv, s, p, &s->slot.state.params, t, SL_PHASE_NONE, err);
     sl_scene_path_destroy(p);
     return st;
 }
@@ -208,8 +208,8 @@ double sl_play_tick(sl_server *srv)
         sl_session *s = NULL;
         pthread_mutex_lock(&srv->lock);
         int n = 0;
-        for (sl_session *t = srv->sessions; t && !s; t = t->next)
-            if (!t->doomed && t->play && n++ == i)
+        for (sl_session *t = sl_sessions_first(srv); t && !s; t = sl_session_next(t))
+            if (!t->slot.doomed && t->play && n++ == i)
                 s = t;
         pthread_mutex_unlock(&srv->lock);
         if (!s)

@@ -17,7 +17,7 @@
  * (a restored session starts with a fresh render and no controller until
  * its first client). Service thread only.
  */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -2,7 +2,7 @@
  * into every client's pending one (newest value wins), the version bump that wakes the render
  * thread, who holds control, camera and parameters set by the server itself (playback), and
  * the render queue's length for /healthz. Service thread (the queue: lock held). */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <string.h>
 
@@ -13,7 +13,7 @@
 
 cJSON *sl_session_state_json(const sl_session *s)
 {
-    const sl_session_state *st = &s->state;
+    const sl_session_state *st = &s->slot.state;
     sl_msg_state m = {.version = st->version, .dataset = st->dataset, .technique = st->technique,
                       .params = &st->params, .camera = &st->camera, .camera_seq = st->camera_seq,
                       .width = st->width, .height = st->height, .background = st->background, .stream = &st->stream,
@@ -37,7 +37,7 @@ void sl_session_broadcast_patch(sl_session *s, cJSON *patch)
             else
                 cJSON_AddItemToObject(c->patch, it->string, dup);
         }
-        c->patch_version = s->state.version;
+        c->patch_version = s->slot.state.version;
         sl_client_wake(c);
     }
     cJSON_Delete(patch);
@@ -46,7 +46,7 @@ void sl_session_broadcast_patch(sl_session *s, cJSON *patch)
 /* Bumps the version, wakes the render thread; caller holds srv->lock. */
 void sl_session_state_changed_locked(sl_server *srv, sl_session *s)
 {
-    s->state.version++;
+    s->slot.state.version++;
     pthread_cond_signal(&srv->wake);
 }
 
@@ -85,11 +85,11 @@ void sl_session_set_view(sl_server *srv, sl_session *s, const sl_camera_spec *ca
                          sl_camera_phase phase)
 {
     pthread_mutex_lock(&srv->lock);
-    s->state.camera = *camera;
+    s->slot.state.camera = *camera;
     if (params)
-        s->state.params = *params;
-    s->state.phase = phase;
-    s->state.camera_ms = sl_clock_ms();
+        s->slot.state.params = *params;
+    s->slot.state.phase = phase;
+    s->slot.state.camera_ms = sl_clock_ms();
     sl_session_state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
@@ -102,8 +102,8 @@ void sl_session_set_view(sl_server *srv, sl_session *s, const sl_camera_spec *ca
 int sl_sessions_render_queue_locked(const sl_server *srv)
 {
     int n = 0;
-    for (const sl_session *s = srv->sessions; s; s = s->next)
-        n += !s->doomed && (s->snap_req_count > 0 || s->state.version != s->rendered_version ||
-                            s->rendered_interactive);
+    for (const sl_session *s = sl_sessions_first(srv); s; s = sl_session_next(s))
+        n += !s->slot.doomed && (s->slot.snap_req_count > 0 || s->slot.state.version != s->slot.rendered_version ||
+                            s->slot.rendered_interactive);
     return n;
 }

@@ -10,10 +10,10 @@
  * The finished file is served once over HTTP, GET /recording/KEY?token=T
  * with the session's token, and removed after; cancelled, failed and
  * undownloaded files are removed with the job (a new job, or the session's
- * end). Service thread, except sl_record_status_locked (render thread,
- * under the lock) and sl_record_free (whoever frees the session).
+ * end). Service thread, except sl_record_free (whoever frees the session). The
+ * job's status texts are render/record_status.c's (both threads post them).
  */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,19 +30,19 @@ sl_status sl_record_create(sl_server *srv, sl_session *s, const cJSON *path, con
     *out = NULL;
     if (!srv->record_dir[0])
         return sl_err_set(err, SL_ERR_UNSUPPORTED, "this server has no folder for recordings");
-    const sl_technique *t = sl_technique_find(s->state.technique);
+    const sl_technique *t = sl_technique_find(s->slot.state.technique);
     if (!t)
-        return sl_err_set(err, SL_ERR_INVALID, "technique %s is not in this build", s->state.technique);
+        return sl_err_set(err, SL_ERR_INVALID, "technique %s is not in this build", s->slot.state.technique);
     sl_scene_path *p = NULL;
     sl_status st = sl_scene_path_parse(path, t, &p, err);
     if (st != SL_OK)
         return st;
     int frames = sl_scene_path_frames(p);
-    double pixels = (double)frames * s->state.width * s->state.height;
+    double pixels = (double)frames * s->slot.state.width * s->slot.state.height;
     if (frames > SL_RECORD_MAX_FRAMES || pixels > SL_RECORD_MAX_PIXELS) {
         sl_scene_path_destroy(p);
         return sl_err_set(err, SL_ERR_INVALID, "path: %d frames of %dx%d; a recording holds at most %d frames and "
-                          "%.0f pixels in all (3600 frames of 1920x1080)", frames, s->state.width, s->state.height,
+                          "%.0f pixels in all (3600 frames of 1920x1080)", frames, s->slot.state.width, s->slot.state.height,
                           SL_RECORD_MAX_FRAMES, SL_RECORD_MAX_PIXELS);
     }
     sl_record_job *j = calloc(1, sizeof *j);
@@ -52,13 +52,13 @@ sl_status sl_record_create(sl_server *srv, sl_session *s, const cJSON *path, con
     }
     j->id = ++srv->next_record_id;
     j->path = p;
-    j->base = s->state;
+    j->base = s->slot.state;
     j->frames = frames;
     j->crf = crf;
     snprintf(j->format, sizeof j->format, "%s", format);
     sl_random_hex(j->key, 16);
     snprintf(j->file, sizeof j->file, "%s/%s-%u.%s", srv->record_dir, s->id, j->id, format);
-    st = sl_video_check(&(sl_video_desc){j->file, s->state.width, s->state.height, p->fps, crf}, err);
+    st = sl_video_check(&(sl_video_desc){j->file, s->slot.state.width, s->slot.state.height, p->fps, crf}, err);
     if (st != SL_OK) {
         sl_record_free(j);
         return st;
@@ -79,32 +79,14 @@ void sl_record_free(sl_record_job *j)
     free(j);
 }
 
-void sl_record_status_locked(sl_session *s, const sl_record_job *j, const char *state, cJSON *extra)
-{
-    cJSON *m = extra ? extra : cJSON_CreateObject();
-    if (!m)
-        return;
-    cJSON_AddStringToObject(m, "type", "recording");
-    cJSON_AddNumberToObject(m, "id", j->id);
-    cJSON_AddStringToObject(m, "state", state);
-    cJSON_AddNumberToObject(m, "frames", j->frames);
-    char *text = cJSON_PrintUnformatted(m);
-    cJSON_Delete(m);
-    if (!text)
-        return;
-    free(s->record_text);
-    s->record_text = text;
-    s->record_seq++;
-}
-
 int sl_record_take_download(sl_server *srv, const char *key, const char *token, char *file, size_t size,
                             const char **mime)
 {
     int status = 404;
     pthread_mutex_lock(&srv->lock);
-    for (sl_session *s = srv->sessions; s; s = s->next) {
-        sl_record_job *j = s->record;
-        if (s->doomed || !j || strcmp(j->key, key) != 0)
+    for (sl_session *s = sl_sessions_first(srv); s; s = sl_session_next(s)) {
+        sl_record_job *j = s->slot.record;
+        if (s->slot.doomed || !j || strcmp(j->key, key) != 0)
             continue;
         if (!j->finished || !j->file[0])
             status = j->finished ? 410 : 404;

@@ -20,7 +20,7 @@
  * Runs on the lws service thread only; it writes shared session fields under
  * srv->lock and reads them without it (it is their only writer).
  */
-#include "sl_server.h"
+#include "sl_sessions.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,15 +36,6 @@
 #include "sl_scene.h"
 #include "sl_scene_path.h"
 
-/* ---------- outgoing messages ---------- */
-
-static char *print_and_free(cJSON *o)
-{
-    char *t = o ? cJSON_PrintUnformatted(o) : NULL;
-    cJSON_Delete(o);
-    return t;
-}
-
 /* ---------- sessions ---------- */
 
 /* The list is walked under the lock because the render thread unlinks doomed
@@ -53,26 +44,27 @@ static sl_session *find_session(sl_server *srv, const char *id)
 {
     sl_session *found = NULL;
     pthread_mutex_lock(&srv->lock);
-    for (sl_session *s = srv->sessions; s && !found; s = s->next)
-        if (!s->doomed && strcmp(s->id, id) == 0)
+    for (sl_session *s = sl_sessions_first(srv); s && !found; s = sl_session_next(s))
+        if (!s->slot.doomed && strcmp(s->id, id) == 0)
             found = s;
     pthread_mutex_unlock(&srv->lock);
     return found;
 }
 
-void sl_session_free(sl_session *s)
+/* Frees a session (its slot's destroy: the render thread, once the slot is doomed and
+ * unlinked and its scene and load released; or sl_sessions_destroy_all at shutdown). */
+static void session_free(sl_render_slot *slot)
 {
-    if (!s)
-        return;
-    sl_frame_buf_unref(s->latest);
-    sl_frame_buf_unref(s->snap_ready);
-    free(s->info_bounds);
-    free(s->info_counts);
-    free(s->info_attrs);
+    sl_session *s = sl_session_of(slot);
+    sl_frame_buf_unref(s->slot.latest);
+    sl_frame_buf_unref(s->slot.snap_ready);
+    free(s->slot.info_bounds);
+    free(s->slot.info_counts);
+    free(s->slot.info_attrs);
     for (int i = 0; i < SL_PROGRESS_RING; i++)
-        free(s->progress_text[i]);
-    sl_record_free(s->record);
-    free(s->record_text);
+        free(s->slot.progress_text[i]);
+    sl_record_free(s->slot.record);
+    free(s->slot.record_text);
     sl_scene_path_destroy(s->play);
     free(s->play_text);
     cJSON_Delete(s->bounds);
@@ -115,8 +107,8 @@ static sl_session *alloc_session(sl_server *srv, sl_err *err)
     if (srv->session_count >= srv->cfg.max_sessions) {
         sl_session *oldest = NULL;
         pthread_mutex_lock(&srv->lock);
-        for (sl_session *s = srv->sessions; s; s = s->next)
-            if (!s->doomed && s->client_count == 0 && (!oldest || s->empty_since_ms < oldest->empty_since_ms))
+        for (sl_session *s = sl_sessions_first(srv); s; s = sl_session_next(s))
+            if (!s->slot.doomed && s->client_count == 0 && (!oldest || s->empty_since_ms < oldest->empty_since_ms))
                 oldest = s;
         if (!oldest) {
             pthread_mutex_unlock(&srv->lock);
@@ -125,7 +117,7 @@ static sl_session *alloc_session(sl_server *srv, sl_err *err)
         }
         char id[sizeof oldest->id];
         memcpy(id, oldest->id, sizeof id);
-        oldest->doomed = 1;   /* the render thread may free it from here on */
+        oldest->slot.doomed = 1;   /* the render thread may free it from here on */
         srv->session_count--;
         pthread_cond_signal(&srv->wake);
         pthread_mutex_unlock(&srv->lock);
@@ -134,6 +126,8 @@ static sl_session *alloc_session(sl_server *srv, sl_err *err)
     sl_session *s = calloc(1, sizeof *s);
     if (!s)
         sl_err_set(err, SL_ERR_NOMEM, "session allocation failed");
+    else
+        s->slot.destroy = session_free;
     return s;
 }
 
@@ -141,10 +135,10 @@ static sl_session *alloc_session(sl_server *srv, sl_err *err)
 static void insert_session(sl_server *srv, sl_session *s)
 {
     s->empty_since_ms = sl_clock_ms();
-    s->idle_since_ms = s->empty_since_ms;
+    s->slot.idle_since_ms = s->empty_since_ms;
     pthread_mutex_lock(&srv->lock);
-    s->next = srv->sessions;
-    srv->sessions = s;
+    s->slot.next = srv->slots;
+    srv->slots = &s->slot;
     srv->session_count++;
     pthread_cond_signal(&srv->wake);
     pthread_mutex_unlock(&srv->lock);
@@ -162,7 +156,7 @@ static sl_session *create_session(sl_server *srv, int width, int height, sl_err 
     sl_random_hex(s->token, 16);
     int tc = 0;
     const sl_technique *const *techs = sl_technique_list(&tc);
-    sl_session_state *st = &s->state;
+    sl_session_state *st = &s->slot.state;
     sl_status rc = SL_ERR_INVALID;
     for (int i = 0; i < tc && rc != SL_OK; i++) {
         rc = pick_default_dataset(srv, techs[i], st, err);
@@ -235,7 +229,7 @@ static sl_session *restore_session(sl_server *srv, const sl_msg *m, const char *
     /* Lengths checked: the parser's session id form, and a token whose hash matched one of 32 digits. */
     snprintf(s->id, sizeof s->id, "%.*s", (int)sizeof s->id - 1, m->session);
     snprintf(s->token, sizeof s->token, "%.*s", (int)sizeof s->token - 1, m->token);
-    s->state = st;
+    s->slot.state = st;
     s->bounds = bounds;
     insert_session(srv, s);
     sl_checkpoint_write(srv, s); /* ownership: this node's id in the row */
@@ -258,11 +252,11 @@ static void attach(sl_server *srv, sl_session *s, sl_client *c)
     /* So is a finished round of progress; one in flight is sent from its start. */
     pthread_mutex_lock(&srv->lock);
     srv->client_count++;
-    c->error_seq = s->error_seq;
-    s->idle_since_ms = 0;
-    c->progress_seq = s->progress_closed ? s->progress_seq : s->progress_round_start;
+    c->error_seq = s->slot.error_seq;
+    s->slot.idle_since_ms = 0;
+    c->progress_seq = s->slot.progress_closed ? s->slot.progress_seq : s->slot.progress_round_start;
     /* The newest recording state is news while its job runs or waits to be fetched. */
-    c->record_seq = s->record && (!s->record->finished || s->record->ok) ? s->record_seq - 1 : s->record_seq;
+    c->record_seq = s->slot.record && (!s->slot.record->finished || s->slot.record->ok) ? s->slot.record_seq - 1 : s->slot.record_seq;
     pthread_mutex_unlock(&srv->lock);
     c->play_seq = s->play ? s->play_seq - 1 : s->play_seq; /* a path playing is news; a stopped one is not */
     sl_msg_welcome w = {.session = s->id, .token = s->token, .node = srv->cfg.node_id, .client = c->id,
@@ -349,11 +343,11 @@ static int parse_stream(sl_server *srv, sl_client *c, const cJSON *o, sl_stream_
 }
 
 /* Switches dataset and/or technique (and optionally params and camera): scene and load_view. */
-static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const char *technique,
-                        const cJSON *params, const cJSON *camera)
+void sl_session_apply_scene(sl_server *srv, sl_client *c, const char *dataset, const char *technique,
+                            const cJSON *params, const cJSON *camera)
 {
     sl_session *s = c->session;
-    sl_session_state next = s->state;
+    sl_session_state next = s->slot.state;
     sl_err err = {0};
     if (dataset && dataset[0] && strcmp(dataset, next.dataset) != 0) {
         if (sl_catalog_lookup(srv->db, dataset, next.dataset_source, sizeof next.dataset_source,
@@ -383,7 +377,7 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
                  "technique \"%s\" cannot render dataset \"%.100s\": it is a %s dataset and %s renders %s; "
                  "the session keeps \"%.100s\" with \"%s\"",
                  t->name, next.dataset, sl_dataset_kind_name((sl_dataset_kind)next.dataset_kind), t->name, kinds,
-                 s->state.dataset, s->state.technique);
+                 s->slot.state.dataset, s->slot.state.technique);
         sl_client_send_error(srv, c, "bad_field", msg, technique && technique[0] ? "technique" : "dataset");
         return;
     }
@@ -396,12 +390,12 @@ static void apply_scene(sl_server *srv, sl_client *c, const char *dataset, const
     if (camera && !parse_camera(srv, c, camera, &next.camera))
         return;
     next.phase = SL_PHASE_NONE;
-    if (strcmp(next.dataset, s->state.dataset) != 0) {
+    if (strcmp(next.dataset, s->slot.state.dataset) != 0) {
         cJSON_Delete(s->bounds);   /* known again once the render thread has loaded it */
         s->bounds = NULL;
     }
     pthread_mutex_lock(&srv->lock);
-    s->state = next;
+    s->slot.state = next;
     sl_session_state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *full = sl_session_state_json(s);
@@ -469,7 +463,7 @@ static void on_hello(sl_server *srv, sl_client *c, const sl_msg *m)
 static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
-    sl_session_state next = s->state;
+    sl_session_state next = s->slot.state;
     if (m->params && !apply_params(srv, c, &next.params, m->params))
         return;
     if (m->stream && !parse_stream(srv, c, m->stream, &next.stream))
@@ -480,11 +474,11 @@ static void on_set(sl_server *srv, sl_client *c, const sl_msg *m)
         cJSON_ArrayForEach(v, m->background)
             next.background[i++] = (float)v->valuedouble;
     }
-    next.phase = s->play ? s->state.phase : SL_PHASE_NONE; /* a playing path keeps its interactive frames */
+    next.phase = s->play ? s->slot.state.phase : SL_PHASE_NONE; /* a playing path keeps its interactive frames */
     if (s->play && m->params)
         s->play_base = next.params; /* keyed parameters still follow the path over the new values */
     pthread_mutex_lock(&srv->lock);
-    s->state = next;
+    s->slot.state = next;
     sl_session_state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
@@ -504,10 +498,10 @@ static void on_camera(sl_server *srv, sl_client *c, const sl_msg *m)
     if (!parse_camera(srv, c, m->camera, &cam))
         return;
     pthread_mutex_lock(&srv->lock);
-    s->state.camera = cam;
-    s->state.camera_seq = (uint32_t)m->seq;
-    s->state.phase = m->phase;
-    s->state.camera_ms = sl_clock_ms();
+    s->slot.state.camera = cam;
+    s->slot.state.camera_seq = (uint32_t)m->seq;
+    s->slot.state.phase = m->phase;
+    s->slot.state.camera_ms = sl_clock_ms();
     sl_session_state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
@@ -561,78 +555,22 @@ static void on_camera_msg(sl_server *srv, sl_client *c, const sl_msg *m)
 static void on_scene(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_play_stop(srv, c->session, "scene"); /* the path was checked against the technique it replaces */
-    apply_scene(srv, c, m->dataset, m->technique, m->params, m->camera);
+    sl_session_apply_scene(srv, c, m->dataset, m->technique, m->params, m->camera);
 }
 
 static void on_resize(sl_server *srv, sl_client *c, const sl_msg *m)
 {
     sl_session *s = c->session;
     pthread_mutex_lock(&srv->lock);
-    s->state.width = m->width;
-    s->state.height = m->height;
-    s->state.phase = SL_PHASE_NONE;
+    s->slot.state.width = m->width;
+    s->slot.state.height = m->height;
+    s->slot.state.phase = SL_PHASE_NONE;
     sl_session_state_changed_locked(srv, s);
     pthread_mutex_unlock(&srv->lock);
     cJSON *p = cJSON_CreateObject();
     cJSON_AddNumberToObject(p, "width", m->width);
     cJSON_AddNumberToObject(p, "height", m->height);
     sl_session_broadcast_patch(s, p);
-}
-
-static void on_list_datasets(sl_server *srv, sl_client *c, const sl_msg *m)
-{
-    (void)m;
-    sl_client_queue_text(c, sl_msg_list_text("datasets", "datasets", sl_catalog_list_json(srv->db, 0)));
-}
-
-static void on_list_views(sl_server *srv, sl_client *c, const sl_msg *m)
-{
-    (void)m;
-    sl_client_queue_text(c, sl_msg_list_text("views", "views", sl_catalog_list_views_json(srv->db)));
-}
-
-static void on_list_paths(sl_server *srv, sl_client *c, const sl_msg *m)
-{
-    (void)m;
-    sl_client_queue_text(c, sl_msg_list_text("paths", "paths", sl_catalog_list_paths_json(srv->db)));
-}
-
-/* Views are one catalog-wide namespace that save_view may overwrite, so only a controller
- * (who can change what the session shows anyway) may write it. */
-static void on_save_view(sl_server *srv, sl_client *c, const sl_msg *m)
-{
-    sl_session *s = c->session;
-    sl_err err = {0};
-    char *params = print_and_free(sl_params_to_json(&s->state.params));
-    char *camera = print_and_free(sl_camera_to_json(&s->state.camera));
-    sl_status st = camera ? sl_catalog_save_view(srv->db, m->name, s->state.dataset, s->state.technique,
-                                                 params ? params : "{}", camera, &err)
-                          : sl_err_set(&err, SL_ERR_NOMEM, "out of memory writing the view's camera");
-    free(params);
-    free(camera);
-    if (st)
-        sl_client_send_error(srv, c, st == SL_ERR_LIMIT ? "limit" : "internal", err.message, "name");
-    else
-        sl_client_queue_text(c, sl_msg_view_saved_text(m->name));
-}
-
-static void on_load_view(sl_server *srv, sl_client *c, const sl_msg *m)
-{
-    sl_play_stop(srv, c->session, "scene");
-    sl_err err = {0};
-    cJSON *v = NULL;
-    if (sl_catalog_load_view(srv->db, m->name, &v, &err) != SL_OK || !v) {
-        sl_client_send_error(srv, c, "not_found", v ? err.message : "no saved view with that name", "name");
-        cJSON_Delete(v);
-        return;
-    }
-    const cJSON *ds = cJSON_GetObjectItemCaseSensitive(v, "dataset");
-    const cJSON *tq = cJSON_GetObjectItemCaseSensitive(v, "technique");
-    const cJSON *pa = cJSON_GetObjectItemCaseSensitive(v, "params");
-    const cJSON *ca = cJSON_GetObjectItemCaseSensitive(v, "camera");
-    apply_scene(srv, c, cJSON_IsString(ds) ? ds->valuestring : NULL, cJSON_IsString(tq) ? tq->valuestring : NULL,
-                cJSON_IsObject(pa) ? pa : NULL, cJSON_IsObject(ca) ? ca : NULL);
-    cJSON_Delete(v);
 }
 
 static void on_ack(sl_server *srv, sl_client *c, const sl_msg *m)
@@ -651,8 +589,8 @@ static void on_snapshot(sl_server *srv, sl_client *c, const sl_msg *m)
     (void)m;
     sl_session *s = c->session;
     pthread_mutex_lock(&srv->lock);
-    if (s->snap_req_count < SL_SESSION_MAX_SNAPSHOTS) {
-        s->snap_req[s->snap_req_count++] = c->id;
+    if (s->slot.snap_req_count < SL_SESSION_MAX_SNAPSHOTS) {
+        s->slot.snap_req[s->slot.snap_req_count++] = c->id;
         pthread_cond_signal(&srv->wake);
         pthread_mutex_unlock(&srv->lock);
     } else {
@@ -681,10 +619,10 @@ static const struct {
     {SL_MSG_SET, 1, on_set},
     {SL_MSG_SCENE, 1, on_scene},
     {SL_MSG_RESIZE, 1, on_resize},
-    {SL_MSG_LIST_DATASETS, 0, on_list_datasets},
-    {SL_MSG_LIST_VIEWS, 0, on_list_views},
-    {SL_MSG_SAVE_VIEW, 1, on_save_view},
-    {SL_MSG_LOAD_VIEW, 1, on_load_view},
+    {SL_MSG_LIST_DATASETS, 0, sl_on_list_datasets},
+    {SL_MSG_LIST_VIEWS, 0, sl_on_list_views},
+    {SL_MSG_SAVE_VIEW, 1, sl_on_save_view},
+    {SL_MSG_LOAD_VIEW, 1, sl_on_load_view},
     {SL_MSG_ACK, 0, on_ack},
     {SL_MSG_SNAPSHOT, 0, on_snapshot},
     {SL_MSG_CONTROL, 0, on_control},
@@ -692,7 +630,7 @@ static const struct {
     {SL_MSG_RECORD, 1, sl_on_record},
     {SL_MSG_RECORD_CANCEL, 1, sl_on_record_cancel},
     {SL_MSG_SAVE_PATH, 1, sl_on_save_path},
-    {SL_MSG_LIST_PATHS, 0, on_list_paths},
+    {SL_MSG_LIST_PATHS, 0, sl_on_list_paths},
     {SL_MSG_LOAD_PATH, 0, sl_on_load_path},
     {SL_MSG_PLAY_PATH, 1, sl_on_play},
     {SL_MSG_PLAY_STOP, 1, sl_on_play},
@@ -750,12 +688,12 @@ void sl_sessions_on_close(sl_server *srv, sl_client *c)
             s->empty_since_ms = sl_clock_ms();
         pthread_mutex_lock(&srv->lock);
         if (s->client_count == 0) {
-            s->idle_since_ms = s->empty_since_ms; /* the render thread lets go of its prepared state later */
+            s->slot.idle_since_ms = s->empty_since_ms; /* the render thread lets go of its prepared state later */
             pthread_cond_signal(&srv->wake);
         }
-        for (int i = 0; i < s->snap_req_count; i++)
-            if (s->snap_req[i] == c->id)
-                s->snap_req[i] = 0;
+        for (int i = 0; i < s->slot.snap_req_count; i++)
+            if (s->slot.snap_req[i] == c->id)
+                s->slot.snap_req[i] = 0;
         pthread_mutex_unlock(&srv->lock);
     }
     for (int i = 0; i < c->reply_count; i++)

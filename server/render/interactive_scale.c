@@ -13,7 +13,7 @@
  * by its cost change (the view moved). A new scene key starts afresh.
  * Render thread only; does not decide when a frame is interactive.
  */
-#include "sl_server.h"
+#include "sl_render.h"
 
 #include <string.h>
 
