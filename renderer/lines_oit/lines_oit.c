@@ -202,10 +202,17 @@ static void draw_lists(lines_oit_state *s, const sl_params *params, const sl_lin
     glDepthMask(GL_FALSE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
+    /* On a multisampled target a triangle makes a fragment wherever it covers any
+     * sample, so every pixel an inner mesh edge (or a silhouette) passes through
+     * would get one node from each triangle: the same tube crossing stored twice
+     * and tubes widened by up to half a pixel. Single-sample rasterization (pixel
+     * centre) gives one node per crossing, as in a single-sample frame. */
+    glDisable(GL_MULTISAMPLE);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glBindVertexArray(s->vao);
     glDrawElements(GL_TRIANGLES, s->index_count, GL_UNSIGNED_INT, NULL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glEnable(GL_MULTISAMPLE);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT |
                     GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint used = 0;

@@ -5,6 +5,7 @@
  *            [--radius R | --radius-frac F] [--opacity A] [--orbit AZ,EL,DIST]
  *            [--colors on|off] [--flat on|off] [--grid N] [--quant N] [--sides N]
  *            [--tol-mean F] [--tol-p99 F] [--tol-crossings F] [--out-dir DIR]
+ *            [--background R,G,B] [--backend auto|gl|cpu]
  * SOURCE is a file (.trk, .tck, .vtk, ...) or generator JSON. Every polyline
  * gets its own colour (a per-vertex attribute constant along the polyline,
  * spread over the viridis colormap by the golden ratio so neighbours differ;
@@ -28,6 +29,9 @@
  * blending, e.g. tubes_mesh, from sorted). Exit 0 when every technique
  * meets its expectation, 1 when one does not, 2 bad input, 3 GPU failure,
  * 77 when SOURCE is a file that does not exist (sample data not fetched).
+ * --background (0..1 each, default 0.1,0.1,0.12) is the clear colour of the
+ * frames and the reference; --backend sets the `backend` parameter of the
+ * techniques that have one (voxel_lines: the ray cast on the GPU or the CPU).
  * Render thread = main.
  */
 #include <math.h>
@@ -48,7 +52,8 @@
 #define MAX_TECHNIQUES 4
 
 typedef struct options {
-    const char *data, *out_dir;
+    const char *data, *out_dir, *backend;
+    float background[3];
     const char *techniques[MAX_TECHNIQUES];
     int expect_fail[MAX_TECHNIQUES]; /* 1: this technique must fail the limits */
     int technique_count;
@@ -83,6 +88,8 @@ static sl_status technique_params(const sl_technique *t, const options *o, doubl
         st = set_num(p, "sides", o->sides, err);
     if (st == SL_OK)
         st = set_num(p, "caps", 0, err);
+    if (st == SL_OK && o->backend && sl_params_find(p, "backend") >= 0)
+        st = sl_params_set_choice(p, "backend", o->backend, err);
     if (st == SL_OK && o->flat) {
         double white[3] = {1.0, 1.0, 1.0};
         st = sl_params_set_numbers(p, "color", white, 3, err);
@@ -245,7 +252,13 @@ static int parse_args(int argc, char **argv, options *o)
                 fprintf(stderr, "transparency-check: --orbit wants AZ,EL,DIST, got %s\n", v);
                 return 2;
             }
-        } else if (strcmp(k, "--colors") == 0) o->colors = strcmp(v, "off") != 0;
+        } else if (strcmp(k, "--background") == 0) {
+            if (sscanf(v, "%f,%f,%f", &o->background[0], &o->background[1], &o->background[2]) != 3) {
+                fprintf(stderr, "transparency-check: --background wants R,G,B in 0..1, got %s\n", v);
+                return 2;
+            }
+        } else if (strcmp(k, "--backend") == 0) o->backend = v;
+        else if (strcmp(k, "--colors") == 0) o->colors = strcmp(v, "off") != 0;
         else if (strcmp(k, "--flat") == 0) o->flat = strcmp(v, "off") != 0;
         else if (strcmp(k, "--radius") == 0) o->radius = atof(v);
         else if (strcmp(k, "--radius-frac") == 0) o->radius_frac = atof(v);
@@ -284,7 +297,7 @@ static sl_status open_dataset(const char *source, sl_dataset **out, sl_err *err)
 int main(int argc, char **argv)
 {
     options o = {.width = 320, .height = 240, .grid = 128, .quant = 256, .sides = 24, .colors = 1,
-                 .radius_frac = 0.004, .opacity = 0.6, .tol_mean = 3.0, .tol_p99 = 30.0,
+                 .radius_frac = 0.004, .opacity = 0.6, .background = {0.1f, 0.1f, 0.12f}, .tol_mean = 3.0, .tol_p99 = 30.0,
                  .orbit = {.azimuth_deg = 40, .elevation_deg = 25, .distance = 1.6, .fov_y_deg = 45}};
     int rc = parse_args(argc, argv, &o);
     if (rc)
@@ -313,7 +326,7 @@ int main(int argc, char **argv)
     }
     double radius = o.radius > 0.0 ? o.radius : o.radius_frac * sl_dataset_radius(ds);
     sl_view view = {.width = o.width, .height = o.height, .quality = SL_QUALITY_STILL,
-                    .background = {0.1f, 0.1f, 0.12f, 1.0f}, .origin = ds->origin};
+                    .background = {o.background[0], o.background[1], o.background[2], 1.0f}, .origin = ds->origin};
     if (sl_camera_from_orbit(&o.orbit, ds->bounds_min, ds->bounds_max, &view.camera, &err) != SL_OK ||
         sl_view_init(&view, sl_dataset_radius(ds), &err) != SL_OK) {
         fprintf(stderr, "transparency-check: camera: %s\n", err.message);
