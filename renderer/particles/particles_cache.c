@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/sl_hash.h"
 #include "../gpu/sl_gpu.h"
 
 typedef struct cache_entry {
@@ -19,25 +20,15 @@ typedef struct cache_entry {
 static cache_entry entries[PT_CACHE_ENTRIES];
 static uint64_t use_clock, hit_count, store_count;
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
 uint64_t pt_cache_volume_hash(const sl_volume *vol)
 {
-    uint64_t h = 14695981039346656037ull;
-    h = fnv1a(h, vol->dims, sizeof vol->dims);
-    h = fnv1a(h, vol->spacing, sizeof vol->spacing);
-    h = fnv1a(h, &vol->type, sizeof vol->type);
-    h = fnv1a(h, &vol->components, sizeof vol->components);
+    uint64_t h = SL_FNV1A_SEED;
+    h = sl_fnv1a(h, vol->dims, sizeof vol->dims);
+    h = sl_fnv1a(h, vol->spacing, sizeof vol->spacing);
+    h = sl_fnv1a(h, &vol->type, sizeof vol->type);
+    h = sl_fnv1a(h, &vol->components, sizeof vol->components);
     size_t voxels = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * (size_t)vol->components;
-    return fnv1a(h, vol->data, voxels * sl_voxel_type_size(vol->type));
+    return sl_fnv1a(h, vol->data, voxels * sl_voxel_type_size(vol->type));
 }
 
 static int same_desc(const pt_system_desc *a, const pt_system_desc *b)

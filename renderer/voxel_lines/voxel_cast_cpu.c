@@ -23,6 +23,10 @@ void sl_voxel_cast_model_deinit(sl_voxel_cast_model *m)
     free(m->count);
     free(m->ab);
     free(m->key);
+    free(m->abs_ab);
+    free(m->reach_first);
+    free(m->reach_count);
+    free(m->reach_line);
     for (int L = 0; L < SL_VOXEL_CAST_MAX_LEVELS; L++)
         free(m->density[L]);
     free(m->ao);
@@ -38,7 +42,8 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
     m->count = malloc(nv);
     m->ab = malloc(nl * 6 * sizeof *m->ab);
     m->key = malloc(nl * sizeof *m->key);
-    if (!m->first || !m->count || !m->ab || !m->key) {
+    m->abs_ab = malloc(nl * 6 * sizeof *m->abs_ab);
+    if (!m->first || !m->count || !m->ab || !m->key || !m->abs_ab) {
         sl_voxel_cast_model_deinit(m);
         return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for %zu lines", g->line_count);
     }
@@ -59,6 +64,89 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
         }
         m->key[i] = line.attr << 16 | (line.id & 0xffffu);
     }
+    for (int z = 0; z < m->dims[2]; z++)
+        for (int y = 0; y < m->dims[1]; y++)
+            for (int x = 0; x < m->dims[0]; x++) {
+                size_t v = (size_t)x + (size_t)m->dims[0] * ((size_t)y + (size_t)m->dims[1] * z);
+                float corner[3] = {(float)x, (float)y, (float)z};
+                for (uint32_t l = 0; l < m->count[v]; l++) {
+                    size_t i = (size_t)m->first[v] + l;
+                    for (int c = 0; c < 6; c++)
+                        m->abs_ab[6 * i + c] = corner[c % 3] + m->ab[6 * i + c];
+                }
+            }
+    return SL_OK;
+}
+
+/* The voxels [lo, hi] (per axis, clamped to the grid and to home +- R) that the box of
+ * line i's tube, grown by reach, overlaps. */
+static void reach_range(const sl_voxel_cast_model *m, size_t i, const int home[3], int R, float reach, int lo[3],
+                        int hi[3])
+{
+    const float *ab = m->abs_ab + 6 * i;
+    for (int c = 0; c < 3; c++) {
+        float a = ab[c], b = ab[3 + c];
+        int l = (int)floorf((a < b ? a : b) - reach), h = (int)floorf((a > b ? a : b) + reach);
+        l = l < home[c] - R ? home[c] - R : l;
+        h = h > home[c] + R ? home[c] + R : h;
+        lo[c] = l < 0 ? 0 : l;
+        hi[c] = h > m->dims[c] - 1 ? m->dims[c] - 1 : h;
+    }
+}
+
+sl_status sl_voxel_cast_model_reach(sl_voxel_cast_model *m, float radius_g, int R, sl_err *err)
+{
+    if (m->reach_valid && m->reach_radius == radius_g && m->reach_r == R)
+        return SL_OK;
+    m->reach_valid = 0;
+    float reach = radius_g + 2e-3f; /* the walk's box reach (radius + 1e-3) and a margin */
+    size_t nv = (size_t)m->dims[0] * m->dims[1] * m->dims[2];
+    free(m->reach_first);
+    free(m->reach_line);
+    m->reach_line = NULL;
+    m->reach_first = malloc((nv + 1) * sizeof *m->reach_first);
+    if (!m->reach_count)
+        m->reach_count = malloc((nv ? nv : 1) * sizeof *m->reach_count);
+    if (!m->reach_first || !m->reach_count)
+        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for the reach lists");
+    memset(m->reach_count, 0, nv * sizeof *m->reach_count);
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            size_t total = 0;
+            for (size_t v = 0; v < nv; v++) {
+                if (total > UINT32_MAX - m->reach_count[v])
+                    return sl_err_set(err, SL_ERR_LIMIT, "voxel_lines (cpu): reach lists above 2^32 entries");
+                m->reach_first[v] = (uint32_t)total;
+                total += m->reach_count[v];
+                m->reach_count[v] = 0;
+            }
+            m->reach_line = malloc((total ? total : 1) * sizeof *m->reach_line);
+            if (!m->reach_line)
+                return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for %zu reach entries", total);
+        }
+        for (int z = 0; z < m->dims[2]; z++)
+            for (int y = 0; y < m->dims[1]; y++)
+                for (int x = 0; x < m->dims[0]; x++) {
+                    size_t hv = (size_t)x + (size_t)m->dims[0] * ((size_t)y + (size_t)m->dims[1] * z);
+                    int home[3] = {x, y, z};
+                    for (uint32_t l = 0; l < m->count[hv]; l++) {
+                        size_t i = (size_t)m->first[hv] + l;
+                        int lo[3], hi[3];
+                        reach_range(m, i, home, R, reach, lo, hi);
+                        for (int cz = lo[2]; cz <= hi[2]; cz++)
+                            for (int cy = lo[1]; cy <= hi[1]; cy++)
+                                for (int cx = lo[0]; cx <= hi[0]; cx++) {
+                                    size_t v = (size_t)cx + (size_t)m->dims[0] * ((size_t)cy + (size_t)m->dims[1] * cz);
+                                    if (pass == 1)
+                                        m->reach_line[m->reach_first[v] + m->reach_count[v]] = (uint32_t)i;
+                                    m->reach_count[v]++;
+                                }
+                    }
+                }
+    }
+    m->reach_radius = radius_g;
+    m->reach_r = R;
+    m->reach_valid = 1;
     return SL_OK;
 }
 
@@ -362,6 +450,7 @@ typedef struct frame_job {
     float forward[3], right[3], up[3], tan_half, aspect, near_s;
     float light[3];
     sl_host_frame *frame;
+    uint32_t *marks;          /* reach lists: line_count marks per worker, else NULL */
     _Atomic long long voxels, lines, hits;
 } frame_job;
 
@@ -380,7 +469,9 @@ static int outside(const int c[3], const int d[3])
     return c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= d[0] || c[1] >= d[1] || c[2] >= d[2];
 }
 
-static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[4], float *depth, long long work[3])
+/* mark (reach lists): per line, the last ray_id of this worker that tested it. */
+static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint32_t *mark, uint32_t ray_id, uint8_t rgba[4],
+                     float *depth, long long work[3])
 {
     const sl_voxel_cast_model *m = job->m;
     const sl_voxel_cast_params *p = job->p;
@@ -431,6 +522,7 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
     int R = p->neighbors, W = 2 * R + 1;
     int fresh_next = 1;
     int step_axis = 0;
+
     for (int it = 0; it < steps; it++) {
         work[0]++;
         if (p->skip_levels >= 0 && !occupied(p->occupancy, 0, cell)) {
@@ -468,6 +560,27 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
             continue;
         }
         float s_leave = min_f(min_f(t_max[0], t_max[1]), min_f(t_max[2], s_exit));
+        if (p->reach_lists) {
+            /* Every tube that reaches into this voxel is on its list; a line already on an
+             * earlier voxel's list was tested there (mark), so each is tested once a ray. */
+            size_t v = (size_t)cell[0] + (size_t)dims[0] * ((size_t)cell[1] + (size_t)dims[1] * cell[2]);
+            const uint32_t *list = m->reach_line + m->reach_first[v];
+            uint32_t count = m->reach_count[v];
+            for (uint32_t l = 0; l < count; l++) {
+                uint32_t li = list[l];
+                if (mark[li] == ray_id)
+                    continue;
+                mark[li] = ray_id;
+                const float *ab = m->abs_ab + 6 * (size_t)li;
+                float tin, tout, n[3] = {0.0f, 0.0f, 0.0f};
+                work[1]++;
+                if (!capsule(o, d, ab, ab + 3, p->radius_g, &tin, &tout, n))
+                    continue;
+                if (tout < s_near)
+                    continue;
+                add_hit(r, max_f(tin, s_near), tout, n, m->key[li]);
+            }
+        } else {
         int fresh = fresh_next;
         int slabs = fresh ? W : 1;
         for (int sl = 0; sl < slabs; sl++) {
@@ -516,6 +629,7 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
                 }
         }
         fresh_next = R > 0 ? 0 : 1;
+        }
         int used = 0;
         for (int i = 0; i < r->h_count; i++) {
             if (R > 0 && r->h_in[i] >= s_leave)
@@ -575,16 +689,18 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint8_t rgba[
 
 static void cast_tile(void *opaque, int tile, int worker)
 {
-    (void)worker;
     frame_job *job = opaque;
     int x0 = (tile % job->tiles_x) * TILE, y0 = (tile / job->tiles_x) * TILE;
     int x1 = x0 + TILE < job->width ? x0 + TILE : job->width, y1 = y0 + TILE < job->height ? y0 + TILE : job->height;
     ray_state r;
     long long work[3] = {0, 0, 0};
+    uint32_t *mark = job->marks ? job->marks + (size_t)worker * job->m->line_count : NULL;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * (size_t)job->width + (size_t)x;
-            cast_ray(job, x, y, &r, job->frame->rgba + 4 * i, job->frame->depth + i, work);
+            /* a ray's id, unique per worker in the frame (rays < 2^32) */
+            uint32_t ray_id = (uint32_t)i + 1;
+            cast_ray(job, x, y, &r, mark, ray_id, job->frame->rgba + 4 * i, job->frame->depth + i, work);
         }
     atomic_fetch_add(&job->voxels, work[0]);
     atomic_fetch_add(&job->lines, work[1]);
@@ -618,7 +734,17 @@ sl_status sl_voxel_cast_render(const sl_voxel_cast_model *m, const sl_voxel_cast
     atomic_init(&job.voxels, 0);
     atomic_init(&job.lines, 0);
     atomic_init(&job.hits, 0);
-    int threads = sl_parallel_run(job.tiles_x * tiles_y, 0, cast_tile, &job);
+    int workers = sl_parallel_threads();
+    if (p->reach_lists) {
+        if (!m->reach_valid)
+            return sl_err_set(err, SL_ERR_INVALID, "voxel_lines (cpu): the frame needs reach lists the model has not got");
+        job.marks = calloc((size_t)workers * (m->line_count ? m->line_count : 1), sizeof *job.marks);
+        if (!job.marks)
+            return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for %d x %zu line marks", workers,
+                              m->line_count);
+    }
+    int threads = sl_parallel_run(job.tiles_x * tiles_y, workers, cast_tile, &job);
+    free(job.marks);
     frame->premultiplied = 1;
     if (stats) {
         stats->threads = threads;

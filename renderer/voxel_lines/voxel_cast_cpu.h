@@ -4,7 +4,8 @@
  * One ray per pixel (the pixel centre, as gl_FragCoord), the same steps in
  * the same order in float: the 3D DDA front to back with empty-space
  * skipping over the occupancy pyramid (voxel_occupancy.h), the neighbour
- * search of (2R+1)^3 blocks tested once per voxel, capsule intersection,
+ * search of (2R+1)^3 blocks tested once per voxel (read from per-voxel reach
+ * lists, the same lines, instead of sliding the block), capsule intersection,
  * the sorted pending list of MAX_HITS hits with joint merging per local id,
  * the open-interval memory of MAX_OPEN slots, shading (sl_line_shade.h,
  * the GLSL's lighting and colormap), soft shadows from the density mip
@@ -46,6 +47,13 @@ typedef struct sl_voxel_cast_model {
     size_t line_count;
     float *ab;                /* 6 floats per line: a, b relative to the voxel's corner */
     uint32_t *key;            /* per line: attribute byte << 16 | local id */
+    float *abs_ab;            /* 6 floats per line: a, b in grid coordinates (corner + ab, as the walk adds them) */
+    /* The reach lists (sl_voxel_cast_model_reach) of tubes of radius reach_radius with the
+     * neighbour search R = reach_r: per voxel, every line of the voxels within R whose tube's
+     * box, grown by the walk's reach, overlaps it. reach_valid 0: none built. */
+    int reach_valid, reach_r;
+    float reach_radius;
+    uint32_t *reach_first, *reach_count, *reach_line;
     /* Density mip chain (level 0 = dims) and AO field, copied from the GL passes. */
     int density_levels;
     int density_dims[SL_VOXEL_CAST_MAX_LEVELS][3];
@@ -60,6 +68,12 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
 float *sl_voxel_cast_density_level(sl_voxel_cast_model *m, int level, const int d[3], sl_err *err);
 uint8_t *sl_voxel_cast_ao(sl_voxel_cast_model *m, const int d[3], sl_err *err);
 void sl_voxel_cast_model_deinit(sl_voxel_cast_model *m); /* zeroed is fine */
+/* Builds the reach lists for tubes of radius_g voxels and neighbour search R (1 or 2), when
+ * they are not built for these already. With them a still frame's walk reads one list per
+ * voxel instead of testing the (2R+1)^3 neighbours' boxes, and marks each line it tested
+ * (per worker and ray), so every line within reach is tested once a ray, as in the
+ * neighbour search: the same hits, composited in the same order. */
+sl_status sl_voxel_cast_model_reach(sl_voxel_cast_model *m, float radius_g, int R, sl_err *err);
 
 /* The frame's uniforms, as voxel_lines.c sets them for the shader. */
 typedef struct sl_voxel_cast_params {
@@ -79,6 +93,7 @@ typedef struct sl_voxel_cast_params {
     int rep_dims[3];
     float rep_scale;
     const sl_line_shader *shader; /* colormap (range 0..1: t), colour, light, material */
+    int reach_lists;          /* neighbors > 0: walk the model's reach lists (built for radius_g, neighbors) */
 } sl_voxel_cast_params;
 
 typedef struct sl_voxel_cast_stats {

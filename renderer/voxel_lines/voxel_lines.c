@@ -628,7 +628,9 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
             .ao_strength = (float)sl_params_float(params, "ao_strength"),
             .reps = shadow_lines && s->reps_host ? s->reps_host + s->rep_base[rep_level] : NULL,
             .rep_dims = {s->rep_dims[rep_level][0], s->rep_dims[rep_level][1], s->rep_dims[rep_level][2]},
-            .rep_scale = (float)(1 << rep_level), .shader = &shader};
+            .rep_scale = (float)(1 << rep_level), .shader = &shader, .reach_lists = neighbors > 0};
+        if (neighbors > 0 && (st = sl_voxel_cast_model_reach(&s->cpu, radius_g, neighbors, err)) != SL_OK)
+            return st;
         if ((st = sl_host_frame_resize(&s->host, view->width, view->height, err)) != SL_OK ||
             (st = sl_voxel_cast_render(&s->cpu, &cp, view, &s->host, &s->cast, err)) != SL_OK)
             return st;

@@ -28,6 +28,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "core/sl_hash.h"
 #include "data/sl_generate.h"
 #include "data/sl_dataset_open.h"
 #include "data/sl_load.h"
@@ -263,15 +264,12 @@ sl_status sl_catalog_file_checksum(const char *path, long long *size, char hex[S
     FILE *f = fopen(path, "rb");
     if (!f)
         return sl_err_set(err, SL_ERR_IO, "catalog: cannot open %s", path);
-    uint64_t h = 0xcbf29ce484222325ull;
+    uint64_t h = SL_FNV1A_SEED;
     unsigned char buf[65536];
     size_t n;
     long long total = 0;
     while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
-        for (size_t i = 0; i < n; i++) {
-            h ^= buf[i];
-            h *= 0x100000001b3ull;
-        }
+        h = sl_fnv1a(h, buf, n);
         total += (long long)n;
     }
     int bad = ferror(f);

@@ -40,6 +40,7 @@
 
 #include "core/sl_camera.h"
 #include "core/sl_clock.h"
+#include "core/sl_hash.h"
 #include "core/sl_technique.h"
 #include "gpu/sl_gpu.h"
 #include "image/sl_video.h"
@@ -140,31 +141,21 @@ static void release_idle(render_ctx *ctx, double now, double *deadline_ms)
     srv->prepared_scenes = ctx->prepared.count; /* after the memory went back, for /metrics readers */
 }
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 /* What the interactive scale's estimates depend on besides the camera:
  * dataset, technique, parameter values and image size. */
 static uint64_t scene_key(const sl_session_state *st)
 {
-    uint64_t h = 0xcbf29ce484222325ull;
-    h = fnv1a(h, st->dataset_source, strlen(st->dataset_source) + 1);
-    h = fnv1a(h, st->technique, strlen(st->technique) + 1);
-    h = fnv1a(h, st->params.value, sizeof st->params.value[0] * (size_t)st->params.count);
-    h = fnv1a(h, st->params.value_count, sizeof st->params.value_count[0] * (size_t)st->params.count);
-    h = fnv1a(h, st->params.tf, sizeof st->params.tf); /* transfer functions: unused entries are zero */
-    h = fnv1a(h, &st->params.tf2d.count, sizeof st->params.tf2d.count); /* field by field: no padding */
-    h = fnv1a(h, &st->params.tf2d.range, sizeof st->params.tf2d.range);
-    h = fnv1a(h, st->params.tf2d.widget, sizeof st->params.tf2d.widget); /* unused widgets are zero */
-    h = fnv1a(h, &st->width, sizeof st->width);
-    return fnv1a(h, &st->height, sizeof st->height);
+    uint64_t h = SL_FNV1A_SEED;
+    h = sl_fnv1a(h, st->dataset_source, strlen(st->dataset_source) + 1);
+    h = sl_fnv1a(h, st->technique, strlen(st->technique) + 1);
+    h = sl_fnv1a(h, st->params.value, sizeof st->params.value[0] * (size_t)st->params.count);
+    h = sl_fnv1a(h, st->params.value_count, sizeof st->params.value_count[0] * (size_t)st->params.count);
+    h = sl_fnv1a(h, st->params.tf, sizeof st->params.tf); /* transfer functions: unused entries are zero */
+    h = sl_fnv1a(h, &st->params.tf2d.count, sizeof st->params.tf2d.count); /* field by field: no padding */
+    h = sl_fnv1a(h, &st->params.tf2d.range, sizeof st->params.tf2d.range);
+    h = sl_fnv1a(h, st->params.tf2d.widget, sizeof st->params.tf2d.widget); /* unused widgets are zero */
+    h = sl_fnv1a(h, &st->width, sizeof st->width);
+    return sl_fnv1a(h, &st->height, sizeof st->height);
 }
 
 /* A dataset's description (sl_catalog_describe: bounds, counts, attribute
