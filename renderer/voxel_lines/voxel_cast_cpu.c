@@ -192,13 +192,19 @@ static inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0
 
 /* --- Capsule (voxel_lines.frag.glsl: capsule) -------------------------------- */
 
-static int capsule(const float o[3], const float d[3], const float a[3], const float b[3], float r, float *t_in_out,
-                   float *t_out_out, float n[3])
+/* Solved from the ray's point nearest a (parameter s0), as the shader does,
+ * so a far eye's large |o - a| does not cancel the quadratics' terms. */
+static int capsule(const float o_eye[3], const float d[3], const float a[3], const float b[3], float r,
+                   float *t_in_out, float *t_out_out, float n[3])
 {
     float t_in = 1e30f, t_out = -1e30f;
+    float dd = dot3(d, d);
+    float ao[3] = {a[0] - o_eye[0], a[1] - o_eye[1], a[2] - o_eye[2]};
+    float s0 = dot3(ao, d) / dd;
+    float o[3] = {o_eye[0] + s0 * d[0], o_eye[1] + s0 * d[1], o_eye[2] + s0 * d[2]};
     float ba[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, oa[3] = {o[0] - a[0], o[1] - a[1], o[2] - a[2]};
     float baba = dot3(ba, ba), bard = dot3(ba, d), baoa = dot3(ba, oa);
-    float dd = dot3(d, d), rdoa = dot3(d, oa), oaoa = dot3(oa, oa);
+    float rdoa = dot3(d, oa), oaoa = dot3(oa, oa);
     float qa = baba * dd - bard * bard;
     if (qa > 1e-12f * baba * dd) {
         float qb = baba * rdoa - baoa * bard;
@@ -236,8 +242,8 @@ static int capsule(const float o[3], const float d[3], const float a[3], const f
         }
         t_out = max_f(t_out, t1);
     }
-    *t_in_out = t_in;
-    *t_out_out = t_out;
+    *t_in_out = t_in + s0;
+    *t_out_out = t_out + s0;
     return t_in < 1e29f;
 }
 

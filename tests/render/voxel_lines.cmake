@@ -131,9 +131,27 @@ voxel_render_test(voxel_lines.golden_detects_uniform_error
   ${SL_STEPS})
 
 # Lines exactly on voxel faces, edges and corners (grid 16, N = 256) against
-# tubes_mesh depth, and the same data 1e6 units from the origin: same image.
-voxel_render_test(voxel_lines.stress_faces_and_offset
-  voxel-check stress --size 128 --quant 256 --tol-median 0.03 --tol-p95 0.15 --max-mismatch-pct 5)
+# tubes_mesh depth, the same data 1e6 units from the origin: same image, and the
+# lattice from 400 bounding radii through a 0.25 degree lens: depth again (the
+# eye-based capsule quadratics put its median 8.4 (gl) / 10.9 (cpu) radii deep there,
+# now 0.020). Both backends.
+foreach(backend gl cpu)
+  voxel_render_test(voxel_lines.stress_faces_and_offset_${backend}
+    voxel-check stress --size 128 --quant 256 --tol-median 0.03 --tol-p95 0.15 --max-mismatch-pct 5
+    --backend ${backend})
+endforeach()
+
+# The far eye of far_eye.json (tornado from 40 bounding radii, 2.5 degree lens) against
+# tubes_mesh, both backends: max-channel |diff| mean over the covered pixels <= 8
+# (measured 4.20 cpu, 4.19 gl; 52.4 / 53.8 with the quadratics solved from the eye).
+foreach(backend cpu gl)
+  voxel_render_test(voxel_lines.far_eye_${backend}_vs_tubes_mesh
+    ${CMAKE_COMMAND}
+    "-DSTEP1=$<TARGET_FILE:sightline-render>|--scene|${VOXEL_DIR}/far_eye.json|--samples|1|--set|technique=tubes_mesh|--out|${SL_RENDER_OUT}/voxel_lines/far_eye_mesh_${backend}.png"
+    "-DSTEP2=$<TARGET_FILE:sightline-render>|--scene|${VOXEL_DIR}/far_eye.json|--samples|1|--set|params.backend=\"${backend}\"|--out|${SL_RENDER_OUT}/voxel_lines/far_eye_${backend}.png"
+    "-DSTEP3=$<TARGET_FILE:sightline-diff>|${SL_RENDER_OUT}/voxel_lines/far_eye_${backend}.png|${SL_RENDER_OUT}/voxel_lines/far_eye_mesh_${backend}.png|--background|26,26,31|--max-mean|8"
+    ${SL_STEPS})
+endforeach()
 
 # Lines beyond the per-voxel cap are counted in sightline-render --stats
 # (`dropped`), not only on stderr: a cap of 1 line per voxel on the opaque

@@ -23,7 +23,9 @@
  * stress: a lattice of lines exactly on voxel faces, edges and corners
  *   (axis-parallel and through corners, grid 16) passes the depth check, and
  *   the same data 1e6 units from the origin gives the same image (<= 0.5 %
- *   of channels differ by > 2).
+ *   of channels differ by > 2), and seen from 400 bounding radii through a
+ *   0.25 degree lens it passes the depth check again. --backend gl|cpu
+ *   picks voxel_lines' execution (default: its own rule).
  * edge: tubes of 1.5 voxels along the edges of the data's box pass the depth
  *   check (the grid's padding must hold them).
  * effects: empty-space skipping leaves the image unchanged (<= 0.1 % of
@@ -46,7 +48,7 @@
 #include "voxel_lines/voxel_lines.h"
 
 typedef struct options {
-    const char *mode, *data;
+    const char *mode, *data, *backend; /* backend: voxel_lines' choice, NULL = its default */
     int size, quant, grid;
     double opacity, radius_frac;
     double tol_median, tol_p95, max_mismatch_pct, max_mesh_only_pct, tol_mean, tol_p99;
@@ -98,6 +100,8 @@ static sl_status render_mem(sl_pipeline *pipe, const char *name, const options *
             st = set_num(&p, "grid", o->grid, err);
         if (st == SL_OK)
             st = set_num(&p, "alpha_threshold", 1.0, err);
+        if (st == SL_OK && o->backend)
+            st = sl_params_set_choice(&p, "backend", o->backend, err);
     }
     for (int i = 0; i < EXTRA_MAX && extra_bools[i] && st == SL_OK; i++) {
         char key[64];
@@ -691,9 +695,11 @@ static sl_dataset *make_lattice(sl_vec3 offset)
     return ds;
 }
 
-/* Renders the lattice (at `offset`) with voxel_lines opaque into rgba, and
- * checks its depth against tubes_mesh when dist_check. */
-static int lattice_frame(sl_gpu *gpu, options *o, sl_vec3 offset, uint8_t *rgba, int dist_check)
+/* Renders the lattice (at `offset`, seen from `distance` bounding radii
+ * through a `fov` degree lens) with voxel_lines opaque into rgba, and checks
+ * its depth against tubes_mesh when dist_check. */
+static int lattice_frame(sl_gpu *gpu, options *o, sl_vec3 offset, double distance, double fov, uint8_t *rgba,
+                         int dist_check)
 {
     sl_err err = {0};
     sl_pipeline *pipe = NULL;
@@ -704,7 +710,7 @@ static int lattice_frame(sl_gpu *gpu, options *o, sl_vec3 offset, uint8_t *rgba,
     }
     sl_view view = {.width = o->size, .height = o->size, .quality = SL_QUALITY_STILL,
                     .background = {0.1f, 0.1f, 0.12f, 1.0f}, .origin = ds->origin};
-    sl_orbit orbit = {.azimuth_deg = 25, .elevation_deg = 30, .distance = 2.0, .fov_y_deg = 45};
+    sl_orbit orbit = {.azimuth_deg = 25, .elevation_deg = 30, .distance = distance, .fov_y_deg = fov};
     sl_vec3 lo = ds->bounds_min, hi = ds->bounds_max;
     sl_pipeline_set_dataset(pipe, ds);
     int rc = 0;
@@ -722,8 +728,11 @@ static int lattice_frame(sl_gpu *gpu, options *o, sl_vec3 offset, uint8_t *rgba,
     return rc;
 }
 
-/* Lines on faces, edges and corners against tubes_mesh, and the same frame
- * with the data 1e6 units away from the world origin. */
+/* Lines on faces, edges and corners against tubes_mesh, the same frame with
+ * the data 1e6 units away from the world origin, and the lattice seen from
+ * 400 bounding radii (~18 000 tube radii) through a 0.25 degree lens: its
+ * depth against tubes_mesh (the capsule quadratics solved from the eye lost
+ * every digit there: median 8.4-10.9 radii deep). */
 static int check_stress(sl_gpu *gpu, options *o)
 {
     size_t n = (size_t)o->size * o->size;
@@ -731,9 +740,9 @@ static int check_stress(sl_gpu *gpu, options *o)
     int rc = 3;
     if (a && b) {
         o->grid = 16;
-        rc = lattice_frame(gpu, o, sl_v3(0, 0, 0), a, 1);
+        rc = lattice_frame(gpu, o, sl_v3(0, 0, 0), 2.0, 45.0, a, 1);
         if (rc == 0)
-            rc = lattice_frame(gpu, o, sl_v3(1e6, -2e6, 3e6), b, 0);
+            rc = lattice_frame(gpu, o, sl_v3(1e6, -2e6, 3e6), 2.0, 45.0, b, 0);
         if (rc == 0) {
             size_t differ = 0;
             for (size_t i = 0; i < 4 * n; i++)
@@ -741,6 +750,8 @@ static int check_stress(sl_gpu *gpu, options *o)
             printf("stress: far-offset frame differs in %zu of %zu channels by > 2\n", differ, 4 * n);
             rc = differ <= n / 200 ? 0 : 1;
         }
+        int far = lattice_frame(gpu, o, sl_v3(0, 0, 0), 400.0, 0.25, b, 1);
+        rc = rc ? rc : far;
     }
     free(a);
     free(b);
@@ -817,6 +828,7 @@ int main(int argc, char **argv)
         else if (strcmp(k, "--max-mesh-only-pct") == 0) o.max_mesh_only_pct = atof(v);
         else if (strcmp(k, "--tol-mean") == 0) o.tol_mean = atof(v);
         else if (strcmp(k, "--tol-p99") == 0) o.tol_p99 = atof(v);
+        else if (strcmp(k, "--backend") == 0) o.backend = v;
         else {
             fprintf(stderr, "voxel-check: unknown option %s\n", k);
             return 2;
