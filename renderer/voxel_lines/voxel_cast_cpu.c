@@ -13,6 +13,8 @@
 #define MAX_OPEN 32
 #define TILE 16
 
+static inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
 /* --- The model ------------------------------------------------------------ */
 
 void sl_voxel_cast_model_deinit(sl_voxel_cast_model *m)
@@ -25,8 +27,8 @@ void sl_voxel_cast_model_deinit(sl_voxel_cast_model *m)
     free(m->key);
     free(m->abs_ab);
     free(m->reach_first);
-    free(m->reach_count);
     free(m->reach_line);
+    sl_voxel_occupancy_deinit(&m->reach_occupancy);
     for (int L = 0; L < SL_VOXEL_CAST_MAX_LEVELS; L++)
         free(m->density[L]);
     free(m->ao);
@@ -42,7 +44,7 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
     m->count = malloc(nv);
     m->ab = malloc(nl * 6 * sizeof *m->ab);
     m->key = malloc(nl * sizeof *m->key);
-    m->abs_ab = malloc(nl * 6 * sizeof *m->abs_ab);
+    m->abs_ab = malloc(nl * SL_VOXEL_CAST_SPAN * sizeof *m->abs_ab);
     if (!m->first || !m->count || !m->ab || !m->key || !m->abs_ab) {
         sl_voxel_cast_model_deinit(m);
         return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for %zu lines", g->line_count);
@@ -71,8 +73,12 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
                 float corner[3] = {(float)x, (float)y, (float)z};
                 for (uint32_t l = 0; l < m->count[v]; l++) {
                     size_t i = (size_t)m->first[v] + l;
+                    float *span = m->abs_ab + SL_VOXEL_CAST_SPAN * i;
                     for (int c = 0; c < 6; c++)
-                        m->abs_ab[6 * i + c] = corner[c % 3] + m->ab[6 * i + c];
+                        span[c] = corner[c % 3] + m->ab[6 * i + c];
+                    float ba[3] = {span[3] - span[0], span[4] - span[1], span[5] - span[2]};
+                    span[6] = 0.5f * sqrtf(dot3(ba, ba));
+                    span[7] = 0.0f;
                 }
             }
     return SL_OK;
@@ -83,7 +89,7 @@ sl_status sl_voxel_cast_model_build(sl_voxel_cast_model *m, const sl_voxel_grid 
 static void reach_range(const sl_voxel_cast_model *m, size_t i, const int home[3], int R, float reach, int lo[3],
                         int hi[3])
 {
-    const float *ab = m->abs_ab + 6 * i;
+    const float *ab = m->abs_ab + SL_VOXEL_CAST_SPAN * i;
     for (int c = 0; c < 3; c++) {
         float a = ab[c], b = ab[3 + c];
         int l = (int)floorf((a < b ? a : b) - reach), h = (int)floorf((a > b ? a : b) + reach);
@@ -105,24 +111,29 @@ sl_status sl_voxel_cast_model_reach(sl_voxel_cast_model *m, float radius_g, int 
     free(m->reach_line);
     m->reach_line = NULL;
     m->reach_first = malloc((nv + 1) * sizeof *m->reach_first);
-    if (!m->reach_count)
-        m->reach_count = malloc((nv ? nv : 1) * sizeof *m->reach_count);
-    if (!m->reach_first || !m->reach_count)
+    uint32_t *fill = calloc(nv ? nv : 1, sizeof *fill); /* pass 0: each voxel's count; 1: entries placed */
+    if (!m->reach_first || !fill) {
+        free(fill);
         return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for the reach lists");
-    memset(m->reach_count, 0, nv * sizeof *m->reach_count);
+    }
     for (int pass = 0; pass < 2; pass++) {
         if (pass == 1) {
             size_t total = 0;
             for (size_t v = 0; v < nv; v++) {
-                if (total > UINT32_MAX - m->reach_count[v])
+                if (total > UINT32_MAX - fill[v]) {
+                    free(fill);
                     return sl_err_set(err, SL_ERR_LIMIT, "voxel_lines (cpu): reach lists above 2^32 entries");
+                }
                 m->reach_first[v] = (uint32_t)total;
-                total += m->reach_count[v];
-                m->reach_count[v] = 0;
+                total += fill[v];
+                fill[v] = 0;
             }
+            m->reach_first[nv] = (uint32_t)total;
             m->reach_line = malloc((total ? total : 1) * sizeof *m->reach_line);
-            if (!m->reach_line)
+            if (!m->reach_line) {
+                free(fill);
                 return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for %zu reach entries", total);
+            }
         }
         for (int z = 0; z < m->dims[2]; z++)
             for (int y = 0; y < m->dims[1]; y++)
@@ -138,12 +149,23 @@ sl_status sl_voxel_cast_model_reach(sl_voxel_cast_model *m, float radius_g, int 
                                 for (int cx = lo[0]; cx <= hi[0]; cx++) {
                                     size_t v = (size_t)cx + (size_t)m->dims[0] * ((size_t)cy + (size_t)m->dims[1] * cz);
                                     if (pass == 1)
-                                        m->reach_line[m->reach_first[v] + m->reach_count[v]] = (uint32_t)i;
-                                    m->reach_count[v]++;
+                                        m->reach_line[m->reach_first[v] + fill[v]] = (uint32_t)i;
+                                    fill[v]++;
                                 }
                     }
                 }
     }
+    free(fill);
+    uint8_t *listed = malloc(nv ? nv : 1);
+    if (!listed)
+        return sl_err_set(err, SL_ERR_NOMEM, "voxel_lines (cpu): out of memory for the reach occupancy");
+    for (size_t v = 0; v < nv; v++)
+        listed[v] = m->reach_first[v + 1] != m->reach_first[v];
+    sl_voxel_occupancy_deinit(&m->reach_occupancy);
+    sl_status st = sl_voxel_occupancy_build(m->dims, listed, 0, &m->reach_occupancy, err);
+    free(listed);
+    if (st != SL_OK)
+        return st;
     m->reach_radius = radius_g;
     m->reach_r = R;
     m->reach_valid = 1;
@@ -187,8 +209,6 @@ uint8_t *sl_voxel_cast_ao(sl_voxel_cast_model *m, const int d[3], sl_err *err)
  * keep NaN rules and cost a third of the frame. */
 static inline float min_f(float a, float b) { return b < a ? b : a; }
 static inline float max_f(float a, float b) { return b > a ? b : a; }
-
-static inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* --- Capsule (voxel_lines.frag.glsl: capsule) -------------------------------- */
 
@@ -245,6 +265,24 @@ static int capsule(const float o_eye[3], const float d[3], const float a[3], con
     *t_in_out = t_in + s0;
     *t_out_out = t_out + s0;
     return t_in < 1e29f;
+}
+
+/* 0 when ray o + s d (s >= 0) surely misses the sphere of radius br around the
+ * midpoint of span's a, b (inv_dd = 1 / d.d): a cheap test before the capsule's,
+ * for the reach walk, whose lists hold mostly lines a ray passes by. The
+ * closest point is measured from the centre (its error grows with |c - o|:
+ * that margin is added), and a sphere wholly behind the eye is missed. */
+static inline int near_sphere(const float o[3], const float d[3], float inv_dd, const float *span, float br)
+{
+    float co[3] = {0.5f * (span[0] + span[3]) - o[0], 0.5f * (span[1] + span[4]) - o[1],
+                   0.5f * (span[2] + span[5]) - o[2]};
+    float s = dot3(co, d) * inv_dd;
+    float q[3] = {co[0] - s * d[0], co[1] - s * d[1], co[2] - s * d[2]};
+    float margin = br + 1e-6f * (fabsf(co[0]) + fabsf(co[1]) + fabsf(co[2]));
+    float m2 = margin * margin;
+    if (dot3(q, q) > m2)
+        return 0;
+    return s >= 0.0f || dot3(co, co) <= m2;
 }
 
 /* --- Per-ray state: pending hits and open intervals ---------------------------- */
@@ -517,6 +555,7 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint32_t *mar
         inv_b[c] = 1.0f / db;
     }
     float reach = p->radius_g + 1e-3f;
+    float inv_dd = 1.0f / dot3(d, d), bound_pad = 1.01f * p->radius_g + 0.01f;
     float dl = sqrtf(dot3(d, d));
     float view_dir[3] = {-d[0] / dl, -d[1] / dl, -d[2] / dl};
     const float *light = job->light;
@@ -529,15 +568,26 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint32_t *mar
     int fresh_next = 1;
     int step_axis = 0;
 
+    /* The reach walk skips by its lists' own pyramid, and steps through a lone empty voxel
+     * (one with an occupied parent) as through one with an empty list. */
+    const sl_voxel_occupancy *occ = p->reach_lists ? &m->reach_occupancy : p->occupancy;
+    int top = p->skip_levels;
+    if (p->reach_lists && top > m->reach_occupancy.levels - 1)
+        top = m->reach_occupancy.levels - 1;
+
     for (int it = 0; it < steps; it++) {
         work[0]++;
-        if (p->skip_levels >= 0 && !occupied(p->occupancy, 0, cell)) {
-            int L = 0;
-            for (int lv = p->skip_levels; lv >= 1; lv--)
-                if (!occupied(p->occupancy, lv, cell)) {
-                    L = lv;
+        int empty = -1; /* the level of the empty block holding cell; -1: cell is occupied */
+        if (p->skip_levels >= 0 && !occupied(occ, 0, cell)) {
+            empty = 0;
+            for (int lv = top; lv >= 1; lv--)
+                if (!occupied(occ, lv, cell)) {
+                    empty = lv;
                     break;
                 }
+        }
+        if (empty > 0 || (empty == 0 && !p->reach_lists)) {
+            int L = empty;
             float bmin[3], bmax[3], tb[3];
             for (int c = 0; c < 3; c++) {
                 bmin[c] = (float)((cell[c] >> L) << L);
@@ -571,15 +621,17 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint32_t *mar
              * earlier voxel's list was tested there (mark), so each is tested once a ray. */
             size_t v = (size_t)cell[0] + (size_t)dims[0] * ((size_t)cell[1] + (size_t)dims[1] * cell[2]);
             const uint32_t *list = m->reach_line + m->reach_first[v];
-            uint32_t count = m->reach_count[v];
+            uint32_t count = empty == 0 ? 0 : m->reach_first[v + 1] - m->reach_first[v];
             for (uint32_t l = 0; l < count; l++) {
                 uint32_t li = list[l];
                 if (mark[li] == ray_id)
                     continue;
                 mark[li] = ray_id;
-                const float *ab = m->abs_ab + 6 * (size_t)li;
-                float tin, tout, n[3] = {0.0f, 0.0f, 0.0f};
+                const float *ab = m->abs_ab + SL_VOXEL_CAST_SPAN * (size_t)li;
                 work[1]++;
+                if (!near_sphere(o, d, inv_dd, ab, ab[6] + bound_pad))
+                    continue;
+                float tin, tout, n[3] = {0.0f, 0.0f, 0.0f};
                 if (!capsule(o, d, ab, ab + 3, p->radius_g, &tin, &tout, n))
                     continue;
                 if (tout < s_near)

@@ -15,8 +15,10 @@
  * hit in an sl_host_frame (rows bottom-up), blended into the GL target as
  * the shader's output is (ONE, ONE_MINUS_SRC_ALPHA).
  *
- * The model keeps the lines decoded (endpoints as floats, 28 bytes a line
- * instead of 5-7): decoding once per build, not once per ray and line,
+ * The model keeps the lines decoded (endpoints as floats relative to the
+ * voxel and in grid coordinates with half the length, the reach walk's
+ * bounding sphere: 60 bytes a line instead of 5-7, with the attribute and
+ * local id): decoding once per build, not once per ray and line,
  * is what makes the CPU walk fast; the values are the GLSL's exactly (bin
  * centres are exact in float). Density levels and the AO field are copies
  * of what the GL passes computed (read back once per change).
@@ -39,6 +41,7 @@
 #include "voxel_occupancy.h"
 
 #define SL_VOXEL_CAST_MAX_LEVELS 12
+#define SL_VOXEL_CAST_SPAN 8 /* floats per line of abs_ab: 32 bytes, two lines a cache line */
 
 typedef struct sl_voxel_cast_model {
     int dims[3];
@@ -47,13 +50,20 @@ typedef struct sl_voxel_cast_model {
     size_t line_count;
     float *ab;                /* 6 floats per line: a, b relative to the voxel's corner */
     uint32_t *key;            /* per line: attribute byte << 16 | local id */
-    float *abs_ab;            /* 6 floats per line: a, b in grid coordinates (corner + ab, as the walk adds them) */
+    /* SL_VOXEL_CAST_SPAN floats per line: a, b in grid coordinates (corner + ab, as the
+     * walk adds them), half of |b - a| (the reach walk's bounding sphere), one unused. */
+    float *abs_ab;
     /* The reach lists (sl_voxel_cast_model_reach) of tubes of radius reach_radius with the
      * neighbour search R = reach_r: per voxel, every line of the voxels within R whose tube's
-     * box, grown by the walk's reach, overlaps it. reach_valid 0: none built. */
+     * box, grown by the walk's reach, overlaps it: voxel v's are reach_line[reach_first[v]
+     * .. reach_first[v + 1] - 1]. reach_valid 0: none built. reach_occupancy is the
+     * pyramid of the non-empty lists (undilated: a list holds its neighbours' lines), which
+     * the reach walk skips by, so it steps through no voxel whose list is empty but one
+     * lying alone between voxels whose lists are not. */
     int reach_valid, reach_r;
     float reach_radius;
-    uint32_t *reach_first, *reach_count, *reach_line;
+    uint32_t *reach_first, *reach_line;
+    sl_voxel_occupancy reach_occupancy;
     /* Density mip chain (level 0 = dims) and AO field, copied from the GL passes. */
     int density_levels;
     int density_dims[SL_VOXEL_CAST_MAX_LEVELS][3];

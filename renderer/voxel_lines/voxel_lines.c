@@ -194,7 +194,7 @@ static GLuint make_buffer(const void *data, size_t bytes)
 static sl_status upload_occupancy(voxel_lines_state *s, const uint8_t *counts, sl_err *err)
 {
     sl_voxel_occupancy_deinit(&s->occupancy);
-    sl_status st = sl_voxel_occupancy_build(s->frame.dims, counts, &s->occupancy, err);
+    sl_status st = sl_voxel_occupancy_build(s->frame.dims, counts, SL_VOXEL_OCCUPANCY_DILATE, &s->occupancy, err);
     if (st != SL_OK)
         return st;
     const sl_voxel_occupancy *o = &s->occupancy;

@@ -1,4 +1,4 @@
-/* voxel_occupancy.c — voxel_occupancy.h: separable max over 5 voxels, then 2^3 maxima per level. */
+/* voxel_occupancy.c — voxel_occupancy.h: separable max over 2 dilate + 1 voxels, then 2^3 maxima per level. */
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,9 +14,12 @@ void sl_voxel_occupancy_deinit(sl_voxel_occupancy *o)
     *o = (sl_voxel_occupancy){0};
 }
 
-sl_status sl_voxel_occupancy_build(const int dims[3], const uint8_t *counts, sl_voxel_occupancy *out, sl_err *err)
+sl_status sl_voxel_occupancy_build(const int dims[3], const uint8_t *counts, int dilate, sl_voxel_occupancy *out,
+                                   sl_err *err)
 {
     *out = (sl_voxel_occupancy){0};
+    if (dilate < 0 || dilate > 2)
+        return sl_err_set(err, SL_ERR_INVALID, "voxel_lines: occupancy dilation %d (0..2)", dilate);
     size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
     int maxdim = dims[0] > dims[1] ? dims[0] : dims[1];
     maxdim = maxdim > dims[2] ? maxdim : dims[2];
@@ -32,11 +35,11 @@ sl_status sl_voxel_occupancy_build(const int dims[3], const uint8_t *counts, sl_
     for (size_t v = 0; v < n; v++)
         a[v] = counts[v] != 0;
     size_t stride[3] = {1, (size_t)dims[0], (size_t)dims[0] * (size_t)dims[1]};
-    for (int ax = 0; ax < 3; ax++) {
+    for (int ax = 0; ax < 3 && dilate > 0; ax++) {
         for (size_t v = 0; v < n; v++) {
             int c = (int)(v / stride[ax] % (size_t)dims[ax]);
             uint8_t m = 0;
-            for (int k = -2; k <= 2; k++)
+            for (int k = -dilate; k <= dilate; k++)
                 if (c + k >= 0 && c + k < dims[ax])
                     m |= a[(size_t)((ptrdiff_t)v + (ptrdiff_t)k * (ptrdiff_t)stride[ax])];
             b[v] = m;
