@@ -579,12 +579,11 @@ static void cast_ray(frame_job *job, int px, int py, ray_state *r, uint32_t *mar
         work[0]++;
         int empty = -1; /* the level of the empty block holding cell; -1: cell is occupied */
         if (p->skip_levels >= 0 && !occupied(occ, 0, cell)) {
+            /* upwards: a level's cell is the max of its children, so above the first
+             * occupied level all are, and a lone empty voxel costs one more load */
             empty = 0;
-            for (int lv = top; lv >= 1; lv--)
-                if (!occupied(occ, lv, cell)) {
-                    empty = lv;
-                    break;
-                }
+            while (empty < top && !occupied(occ, empty + 1, cell))
+                empty++;
         }
         if (empty > 0 || (empty == 0 && !p->reach_lists)) {
             int L = empty;
