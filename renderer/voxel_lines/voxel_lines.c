@@ -636,6 +636,7 @@ static sl_status voxel_lines_render(void *opaque, const sl_view *view, const sl_
             return st;
         counters.cpu_frames++;
         stats->threads = s->cast.threads;
+        stats->samples = s->cast.voxels; /* voxels the rays stepped through (not jumped over) */
         return sl_host_frame_draw(&s->host, err);
     }
 

@@ -141,7 +141,7 @@ volume_test(cli.set_transfer_function
   ${SL_STEPS})
 volume_test(cli.stats_skipped
   ${CMAKE_COMMAND} -DRENDER=$<TARGET_FILE:sightline-render> -DSCENE=${VOLUME_DIR}/head_composite.json
-  -DOUT=${SL_RENDER_OUT} -P ${VOLUME_DIR}/stats_skipped.cmake)
+  -DOUT=${SL_RENDER_OUT} -DNAME=volume_stats -DSKIPPED=1 -P ${CMAKE_SOURCE_DIR}/tests/stats_skipping.cmake)
 
 # Golden images (llvmpipe, 128x128, samples 1, jitter off), one per mode:
 # composite with shading (Marschner-Lobb), mip (head phantom, magma), iso

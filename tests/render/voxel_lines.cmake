@@ -164,6 +164,13 @@ foreach(case "1;some" "255;none")
     -DOUT=${SL_RENDER_OUT} -DCAP=${cap} -DEXPECT=${expect} -P ${VOXEL_DIR}/stats_dropped.cmake)
 endforeach()
 
+# The cpu backend's work counter in --stats: the voxels its rays stepped through
+# (ray_samples), fewer with empty-space skipping than without (tests/stats_skipping.cmake).
+voxel_render_test(voxel_lines.stats_samples_cpu
+  ${CMAKE_COMMAND} -DRENDER=$<TARGET_FILE:sightline-render> -DSCENE=${VOXEL_DIR}/opaque.json
+  -DOUT=${SL_RENDER_OUT} -DNAME=voxel_samples_cpu -DSET=params.backend=cpu
+  -P ${CMAKE_SOURCE_DIR}/tests/stats_skipping.cmake)
+
 # Transparent compositing against the exact CPU reference
 # (tests/support/lines_reference.h: every maximal interval of a ray inside a
 # polyline's capsule-union tube blended once at its entry, all crossings
